@@ -1,0 +1,58 @@
+//! Command-line parsing and dispatch. Each subcommand lives in its own file;
+//! errors are printed once, here, and turn into a non-zero exit.
+
+mod args;
+mod compare;
+mod plot;
+mod progress;
+mod sample;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Design Monte Carlo sample patterns by the integration error they produce.
+#[derive(Parser)]
+#[command(name = "varspec", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Generate point sets with a sampler and write them as CSV or UTK text.
+    Sample(sample::Args),
+    /// Draw pictures (PNG) of point sets.
+    #[command(subcommand)]
+    Plot(plot::PlotCommand),
+    /// Generate every 2D sampler at one N and compare them side by side
+    /// (the default job: try `varspec compare`).
+    Compare(compare::Args),
+}
+
+/// Parses the arguments, runs the subcommand, reports any error on stderr.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Sample(a) => sample::run(a),
+        Command::Plot(c) => plot::run(c),
+        Command::Compare(a) => compare::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Output piped into `head` and closed early is not an error.
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}

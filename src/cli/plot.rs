@@ -1,0 +1,60 @@
+//! `varspec plot`: pictures of point sets.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use clap::Subcommand;
+
+use super::args;
+use varspec::io::read_point_sets;
+use varspec::report::png::{render_points, save_png};
+
+#[derive(Subcommand)]
+pub enum PlotCommand {
+    /// Draw one set of a point-set file, or a 2D projection of it, as PNG.
+    Points(PointsArgs),
+}
+
+#[derive(clap::Args)]
+pub struct PointsArgs {
+    /// Point-set file (CSV or UTK text).
+    file: PathBuf,
+    /// The two dimensions to draw, horizontal then vertical (XU = 0,2; YV = 1,3).
+    #[arg(long, default_value = "0,1")]
+    dims: String,
+    /// Which set of the file to draw (from 0).
+    #[arg(long, default_value_t = 0)]
+    set: usize,
+    /// Image side in pixels.
+    #[arg(long, default_value_t = 512)]
+    size: u32,
+    /// Output PNG.
+    #[arg(short = 'o', long = "output")]
+    output: PathBuf,
+}
+
+pub fn run(c: PlotCommand) -> anyhow::Result<()> {
+    match c {
+        PlotCommand::Points(a) => points(a),
+    }
+}
+
+fn points(a: PointsArgs) -> anyhow::Result<()> {
+    let dims = args::dims(&a.dims, 2)?;
+    if !(16..=8192).contains(&a.size) {
+        bail!("--size {}: choose 16 to 8192 pixels", a.size);
+    }
+    let sets = read_point_sets(&a.file)?;
+    let Some(set) = sets.get(a.set) else {
+        bail!(
+            "{}: --set {} requested, the file holds sets 0..{}",
+            a.file.display(),
+            a.set,
+            sets.len() - 1
+        );
+    };
+    let img = render_points(set, [dims[0], dims[1]], a.size)
+        .with_context(|| format!("{}", a.file.display()))?;
+    save_png(&img, &a.output)?;
+    Ok(())
+}

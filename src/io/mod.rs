@@ -1,0 +1,7 @@
+//! File formats and atomic output.
+
+pub mod atomic;
+pub mod pointfile;
+
+pub use atomic::write_atomic;
+pub use pointfile::{PointFileError, PointFormat, read_point_sets, write_point_sets};

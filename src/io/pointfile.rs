@@ -1,0 +1,418 @@
+//! Point-set files (DESIGN.md §2).
+//!
+//! * **CSV** — a header `x0,x1,…,x{d−1}`, optionally preceded by a `set`
+//!   column that numbers realizations 0, 1, 2, … in order; one point per
+//!   row; f64 written with round-trip precision.
+//! * **UTK text** — the Uni(corn|form) toolkit's format (Perrier, Coeurjolly &
+//!   Ostromoukhov): whitespace-separated coordinates, one point per line, a
+//!   line starting with `#` between point sets.
+//!
+//! Readers detect the format from the first non-blank line (a CSV header
+//! starts with a letter). Values must be finite and in [0, 1); exactly 1.0 is
+//! rejected (on the torus it is 0: write 0); `-0.0` reads as 0.
+
+use std::fmt;
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+
+use crate::points::PointSet;
+
+/// What is wrong with a point-set file, and where.
+#[derive(Debug, thiserror::Error)]
+pub enum PointFileError {
+    /// The file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: io::Error,
+    },
+    /// No points at all.
+    #[error("{path}: the file holds no points")]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A malformed line.
+    #[error("{path}:{line}: {problem}")]
+    Line {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong on it.
+        problem: LineProblem,
+    },
+    /// The points have another dimension than the caller needs.
+    #[error("{path}: points are {found}-dimensional, {expected} dimensions are needed")]
+    WrongDimension {
+        /// The file.
+        path: PathBuf,
+        /// Needed dimension.
+        expected: usize,
+        /// Dimension in the file.
+        found: usize,
+    },
+}
+
+impl PointFileError {
+    /// The 1-based line of a line error.
+    pub fn line(&self) -> Option<usize> {
+        match self {
+            PointFileError::Line { line, .. } => Some(*line),
+            _ => None,
+        }
+    }
+}
+
+/// The defect on one line of a point-set file.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LineProblem {
+    /// The CSV header is not `[set,]x0,x1,…`.
+    Header {
+        /// The header found.
+        found: String,
+    },
+    /// A field that is not a number.
+    NotANumber {
+        /// 1-based field.
+        field: usize,
+        /// Its text.
+        text: String,
+    },
+    /// NaN or infinity.
+    NotFinite {
+        /// 1-based field.
+        field: usize,
+        /// Its text.
+        text: String,
+    },
+    /// A value outside [0, 1).
+    OutOfRange {
+        /// 1-based field.
+        field: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A row with the wrong number of fields.
+    Ragged {
+        /// Fields expected.
+        expected: usize,
+        /// Fields found.
+        found: usize,
+    },
+    /// A `set` value that does not continue 0, 1, 2, ….
+    SetNumber {
+        /// The set being read.
+        current: Option<u64>,
+        /// Its text.
+        text: String,
+    },
+}
+
+impl fmt::Display for LineProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LineProblem::Header { found } => write!(
+                f,
+                "CSV header must be `x0,x1,...` or `set,x0,x1,...`, found `{found}`"
+            ),
+            LineProblem::NotANumber { field, text } => {
+                write!(f, "field {field} is `{text}`, not a number")
+            }
+            LineProblem::NotFinite { field, text } => {
+                write!(f, "field {field} is `{text}`, not a finite number")
+            }
+            LineProblem::OutOfRange { field, value } if *value == 1.0 => write!(
+                f,
+                "field {field} is 1, outside [0, 1) (on the torus 1 is the same point as 0: write 0)"
+            ),
+            LineProblem::OutOfRange { field, value } => {
+                write!(f, "field {field} is {value}, outside [0, 1)")
+            }
+            LineProblem::Ragged { expected, found } => {
+                write!(f, "{found} fields where every row has {expected}")
+            }
+            LineProblem::SetNumber {
+                current: None,
+                text,
+            } => {
+                write!(f, "the `set` column must start at 0, found `{text}`")
+            }
+            LineProblem::SetNumber {
+                current: Some(c),
+                text,
+            } => write!(
+                f,
+                "the `set` column must continue with {c} or {}, found `{text}`",
+                c + 1
+            ),
+        }
+    }
+}
+
+/// A point-set file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointFormat {
+    /// CSV with a `[set,]x0,…` header.
+    Csv,
+    /// UTK's whitespace text with `#` between sets.
+    Utk,
+}
+
+/// Reads every point set in `path` (CSV or UTK text, detected).
+///
+/// # Errors
+/// [`PointFileError`] naming the file and, for malformed content, the line.
+pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
+    let file = File::open(path).map_err(|source| PointFileError::Io {
+        path: path.into(),
+        source,
+    })?;
+    parse_point_sets(BufReader::new(file), path)
+}
+
+/// Reads `path` and checks that its points have dimension `dim`.
+///
+/// # Errors
+/// As [`read_point_sets`], plus [`PointFileError::WrongDimension`].
+pub fn read_point_sets_of_dim(path: &Path, dim: usize) -> Result<Vec<PointSet>, PointFileError> {
+    let sets = read_point_sets(path)?;
+    match sets[0].dim() {
+        d if d == dim => Ok(sets),
+        found => Err(PointFileError::WrongDimension {
+            path: path.into(),
+            expected: dim,
+            found,
+        }),
+    }
+}
+
+/// Parses point sets from `reader`; `path` names the source in errors.
+///
+/// # Errors
+/// As [`read_point_sets`].
+pub fn parse_point_sets<R: BufRead>(
+    reader: R,
+    path: &Path,
+) -> Result<Vec<PointSet>, PointFileError> {
+    let mut parser = Parser {
+        path,
+        sets: Vec::new(),
+        current: Vec::new(),
+        dim: 0,
+        set_column: false,
+        set_id: None,
+        format: None,
+    };
+    for (idx, line) in reader.lines().enumerate() {
+        let line = line.map_err(|source| PointFileError::Io {
+            path: path.into(),
+            source,
+        })?;
+        parser
+            .line(line.trim_end_matches('\r'))
+            .map_err(|problem| PointFileError::Line {
+                path: path.into(),
+                line: idx + 1,
+                problem,
+            })?;
+    }
+    parser.finish()
+}
+
+struct Parser<'a> {
+    path: &'a Path,
+    sets: Vec<PointSet>,
+    current: Vec<f64>,
+    dim: usize,
+    set_column: bool,
+    set_id: Option<u64>,
+    format: Option<PointFormat>,
+}
+
+impl Parser<'_> {
+    fn line(&mut self, line: &str) -> Result<(), LineProblem> {
+        let text = line.trim();
+        if text.is_empty() {
+            return Ok(());
+        }
+        match self.format {
+            None if text.starts_with(|c: char| c.is_ascii_alphabetic()) => self.csv_header(text),
+            None if text.starts_with('#') => {
+                self.format = Some(PointFormat::Utk);
+                Ok(())
+            }
+            None if text.contains(',') => Err(LineProblem::Header {
+                found: text.to_string(),
+            }),
+            None => {
+                self.format = Some(PointFormat::Utk);
+                self.utk_row(text)
+            }
+            Some(PointFormat::Csv) => self.csv_row(text),
+            Some(PointFormat::Utk) if text.starts_with('#') => {
+                self.close_set();
+                Ok(())
+            }
+            Some(PointFormat::Utk) => self.utk_row(text),
+        }
+    }
+
+    fn csv_header(&mut self, text: &str) -> Result<(), LineProblem> {
+        let names: Vec<&str> = text.split(',').map(str::trim).collect();
+        self.set_column = names[0] == "set";
+        let coords = &names[usize::from(self.set_column)..];
+        let ok = !coords.is_empty()
+            && coords
+                .iter()
+                .enumerate()
+                .all(|(j, n)| *n == format!("x{j}"));
+        if !ok {
+            return Err(LineProblem::Header {
+                found: text.to_string(),
+            });
+        }
+        self.dim = coords.len();
+        self.format = Some(PointFormat::Csv);
+        Ok(())
+    }
+
+    fn csv_row(&mut self, text: &str) -> Result<(), LineProblem> {
+        let fields: Vec<&str> = text.split(',').map(str::trim).collect();
+        let expected = self.dim + usize::from(self.set_column);
+        if fields.len() != expected {
+            return Err(LineProblem::Ragged {
+                expected,
+                found: fields.len(),
+            });
+        }
+        let coords = if self.set_column {
+            self.set_number(fields[0])?;
+            &fields[1..]
+        } else {
+            &fields[..]
+        };
+        let offset = usize::from(self.set_column);
+        for (j, f) in coords.iter().enumerate() {
+            self.current.push(coordinate(f, j + 1 + offset)?);
+        }
+        Ok(())
+    }
+
+    fn set_number(&mut self, text: &str) -> Result<(), LineProblem> {
+        let problem = || LineProblem::SetNumber {
+            current: self.set_id,
+            text: text.to_string(),
+        };
+        let id: u64 = text.parse().map_err(|_| problem())?;
+        match self.set_id {
+            None if id == 0 => self.set_id = Some(0),
+            Some(c) if id == c => {}
+            Some(c) if id == c + 1 => {
+                self.close_set();
+                self.set_id = Some(id);
+            }
+            _ => return Err(problem()),
+        }
+        Ok(())
+    }
+
+    fn utk_row(&mut self, text: &str) -> Result<(), LineProblem> {
+        let fields: Vec<&str> = text.split_whitespace().collect();
+        if self.dim == 0 {
+            self.dim = fields.len();
+        }
+        if fields.len() != self.dim {
+            return Err(LineProblem::Ragged {
+                expected: self.dim,
+                found: fields.len(),
+            });
+        }
+        for (j, f) in fields.iter().enumerate() {
+            self.current.push(coordinate(f, j + 1)?);
+        }
+        Ok(())
+    }
+
+    fn close_set(&mut self) {
+        if !self.current.is_empty() {
+            let coords = std::mem::take(&mut self.current);
+            // Values were validated field by field; dimension by row length.
+            let set = PointSet::new(self.dim, coords).expect("validated rows form a point set");
+            self.sets.push(set);
+        }
+    }
+
+    fn finish(mut self) -> Result<Vec<PointSet>, PointFileError> {
+        self.close_set();
+        if self.sets.is_empty() {
+            return Err(PointFileError::Empty {
+                path: self.path.into(),
+            });
+        }
+        Ok(self.sets)
+    }
+}
+
+fn coordinate(text: &str, field: usize) -> Result<f64, LineProblem> {
+    let v: f64 = text.parse().map_err(|_| LineProblem::NotANumber {
+        field,
+        text: text.to_string(),
+    })?;
+    if !v.is_finite() {
+        return Err(LineProblem::NotFinite {
+            field,
+            text: text.to_string(),
+        });
+    }
+    if !(0.0..1.0).contains(&v) {
+        return Err(LineProblem::OutOfRange { field, value: v });
+    }
+    Ok(v + 0.0)
+}
+
+/// Writes point sets in `format`. CSV gets a `set` column when there is more
+/// than one set. Values use Rust's shortest round-trip representation, so
+/// reading the file back gives identical bits.
+///
+/// # Errors
+/// The writer's I/O error.
+pub fn write_point_sets(
+    out: &mut dyn Write,
+    sets: &[PointSet],
+    format: PointFormat,
+) -> io::Result<()> {
+    let dim = sets.first().map_or(0, PointSet::dim);
+    let numbered = sets.len() > 1;
+    if format == PointFormat::Csv {
+        let names: Vec<String> = (0..dim).map(|j| format!("x{j}")).collect();
+        writeln!(
+            out,
+            "{}{}",
+            if numbered { "set," } else { "" },
+            names.join(",")
+        )?;
+    }
+    for (s, set) in sets.iter().enumerate() {
+        if format == PointFormat::Utk && s > 0 {
+            writeln!(out, "#")?;
+        }
+        let sep = if format == PointFormat::Csv { ',' } else { ' ' };
+        for p in set.points() {
+            if format == PointFormat::Csv && numbered {
+                write!(out, "{s},")?;
+            }
+            for (j, v) in p.iter().enumerate() {
+                if j > 0 {
+                    write!(out, "{sep}")?;
+                }
+                write!(out, "{v:?}")?;
+            }
+            writeln!(out)?;
+        }
+    }
+    Ok(())
+}

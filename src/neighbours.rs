@@ -1,0 +1,113 @@
+//! Neighbour queries on the torus with a uniform cell grid: each point is
+//! binned once, and a query visits only the cells within reach, so a search
+//! of radius ~ N^(−1/d) costs O(1) per point instead of O(N).
+
+use crate::points::{PointSet, toroidal_distance_sq};
+
+/// Points binned into g^d cells of side 1/g (counting sort, CSR layout).
+pub struct CellGrid<'a> {
+    points: &'a PointSet,
+    g: usize,
+    /// start[c]..start[c+1] indexes `order` for cell c.
+    start: Vec<u32>,
+    order: Vec<u32>,
+}
+
+impl<'a> CellGrid<'a> {
+    /// Bins `points` with about one point per cell (g = ⌊N^(1/d)⌋, capped at
+    /// 2^20 cells).
+    pub fn new(points: &'a PointSet) -> Self {
+        let (n, d) = (points.len(), points.dim());
+        let cap = ((1usize << 20) as f64).powf(1.0 / d as f64).floor() as usize;
+        let g = ((n as f64).powf(1.0 / d as f64).floor() as usize).clamp(1, cap.max(1));
+        let cell_of = |p: &[f64]| {
+            p.iter().rev().fold(0usize, |acc, &x| {
+                acc * g + ((x * g as f64) as usize).min(g - 1)
+            })
+        };
+        let cells = g.pow(d as u32);
+        let mut start = vec![0u32; cells + 1];
+        for p in points.points() {
+            start[cell_of(p) + 1] += 1;
+        }
+        for c in 0..cells {
+            start[c + 1] += start[c];
+        }
+        let mut fill = start.clone();
+        let mut order = vec![0u32; n];
+        for (i, p) in points.points().enumerate() {
+            let c = cell_of(p);
+            order[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        }
+        CellGrid {
+            points,
+            g,
+            start,
+            order,
+        }
+    }
+
+    /// Calls `visit(j, dist²)` for every point j ≠ i within toroidal distance
+    /// `radius` of point i (radius < 1/2 for each periodic image to count
+    /// once).
+    pub fn for_each_within(&self, i: usize, radius: f64, mut visit: impl FnMut(usize, f64)) {
+        let d = self.points.dim();
+        let g = self.g as isize;
+        let p = self.points.point(i);
+        let reach = (radius * self.g as f64).ceil() as isize;
+        // At most g cells per axis, so every cell (and periodic image) is
+        // visited once even when the reach wraps around the torus.
+        let side = (2 * reach + 1).min(g) as usize;
+        let lo: Vec<isize> = p
+            .iter()
+            .map(|&x| ((x * g as f64) as isize).min(g - 1) - reach)
+            .collect();
+        let r2 = radius * radius;
+        let mut offset = vec![0usize; d];
+        for idx in 0..side.pow(d as u32) {
+            let mut rest = idx;
+            for o in offset.iter_mut() {
+                *o = rest % side;
+                rest /= side;
+            }
+            let cell = (0..d).rev().fold(0usize, |acc, j| {
+                acc * self.g + (lo[j] + offset[j] as isize).rem_euclid(g) as usize
+            });
+            for &k in &self.order[self.start[cell] as usize..self.start[cell + 1] as usize] {
+                let k = k as usize;
+                if k != i {
+                    let d2 = toroidal_distance_sq(p, self.points.point(k));
+                    if d2 <= r2 {
+                        visit(k, d2);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Distance from each point to its nearest neighbour on the torus.
+///
+/// Searches the cells within twice the mean spacing first and widens only
+/// for points with no neighbour there.
+pub fn nearest_neighbour_distances(points: &PointSet) -> Vec<f64> {
+    let n = points.len();
+    let d = points.dim();
+    let grid = CellGrid::new(points);
+    let spacing = (1.0 / n.max(1) as f64).powf(1.0 / d as f64);
+    let max_radius = 0.5 * (d as f64).sqrt();
+    (0..n)
+        .map(|i| {
+            let mut radius = 2.0 * spacing;
+            loop {
+                let mut best = f64::INFINITY;
+                grid.for_each_within(i, radius.min(max_radius), |_, d2| best = best.min(d2));
+                if best.is_finite() || radius >= max_radius || n < 2 {
+                    return best.sqrt();
+                }
+                radius *= 2.0;
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,3 @@
+//! Reports: pictures and tables people look at.
+
+pub mod png;

@@ -1,0 +1,104 @@
+//! Stratified sampling on the m^d grid: regular (cell centres), jittered (an
+//! independent uniform offset per stratum) and uniform jitter (one offset
+//! shared by all strata) are one sampler with the offset as a parameter
+//! (STYLE.md §3).
+//!
+//! Jitter's expected power spectrum is E[N·P_S(k)] = 1 − Π_j sinc²(π k_j/m)
+//! (Pilleboue et al. 2015, "Variance analysis for Monte Carlo integration",
+//! ACM TOG 34(4), §5), zero at every nonzero multiple of m.
+
+use super::registry::{Config, integer_root, pow_saturating};
+use super::{Sampler, SamplerError};
+use crate::points::{PointSet, stratum_coord};
+use crate::rng::{SetRng, uniform};
+
+/// Where in its stratum each point lies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StratumOffset {
+    /// The cell centre: the regular grid.
+    Centre,
+    /// An independent uniform offset per stratum: jittered sampling.
+    Independent,
+    /// One uniform offset shared by every stratum: uniform jitter
+    /// (Ramamoorthi, Anderson, Meyer & Nowrouzezahrai 2012, "A theory of
+    /// Monte Carlo visibility sampling", ACM TOG 31(5)).
+    Shared,
+}
+
+/// One point in each cell of the m^d grid, N = m^d.
+#[derive(Debug, Clone)]
+pub struct Jitter {
+    m: usize,
+    dim: usize,
+    offset: StratumOffset,
+}
+
+impl Jitter {
+    /// The m^d grid in d dimensions with the given offset rule.
+    pub fn new(m: usize, dim: usize, offset: StratumOffset) -> Self {
+        Jitter { m, dim, offset }
+    }
+
+    /// Strata per axis.
+    pub fn strata_per_axis(&self) -> usize {
+        self.m
+    }
+}
+
+fn from_config(c: &Config, offset: StratumOffset) -> Result<Box<dyn Sampler>, SamplerError> {
+    let m = integer_root(c.n, c.dim);
+    if pow_saturating(m, c.dim) != c.n {
+        let below = (m >= 1).then(|| pow_saturating(m, c.dim));
+        let above = Some(pow_saturating(m + 1, c.dim)).filter(|&a| a != usize::MAX);
+        return Err(c.bad_count("N = m^d", below, above));
+    }
+    Ok(Box::new(Jitter::new(m, c.dim, offset)))
+}
+
+pub(super) fn regular_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+    from_config(c, StratumOffset::Centre)
+}
+
+pub(super) fn jitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+    from_config(c, StratumOffset::Independent)
+}
+
+pub(super) fn uniform_jitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+    from_config(c, StratumOffset::Shared)
+}
+
+impl Sampler for Jitter {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+
+    fn len(&self) -> usize {
+        pow_saturating(self.m, self.dim)
+    }
+
+    fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError> {
+        let (m, d) = (self.m, self.dim);
+        let shared: Vec<f64> = match self.offset {
+            StratumOffset::Shared => (0..d).map(|_| uniform(rng)).collect(),
+            _ => vec![0.5; d],
+        };
+        let n = self.len();
+        let mut coords = Vec::with_capacity(n * d);
+        // Point i sits in the stratum whose base-m digits are i's: digit j
+        // (least significant first) is its cell index along axis j.
+        for i in 0..n {
+            let mut rest = i;
+            for &s in &shared {
+                let cell = rest % m;
+                rest /= m;
+                let xi = if self.offset == StratumOffset::Independent {
+                    uniform(rng)
+                } else {
+                    s
+                };
+                coords.push(stratum_coord(cell, xi, m));
+            }
+        }
+        Ok(PointSet::new(d, coords).expect("stratum coordinates lie in [0,1)"))
+    }
+}

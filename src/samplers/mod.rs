@@ -1,0 +1,172 @@
+//! Point-set samplers: one file per family behind the [`Sampler`] trait, and
+//! the registry ([`SAMPLERS`]) that names them for the command line.
+//!
+//! A sampler is an immutable configuration (N, d, parameters); randomness is
+//! handed in as a [`SetRng`] (STYLE.md §2). [`generate_sets`] draws many
+//! realizations in parallel, realization r from stream (seed, r), so the
+//! output is identical for any number of threads.
+
+mod halton;
+mod jitter;
+mod multijitter;
+mod nrooks;
+mod poisson_disk;
+mod random;
+mod registry;
+mod sobol;
+mod sobol_table;
+mod umj;
+
+pub use halton::Halton;
+pub use jitter::{Jitter, StratumOffset};
+pub use multijitter::MultiJitter;
+pub use nrooks::NRooks;
+pub use poisson_disk::{PoissonDisk, packing_radius};
+pub use random::Random;
+pub use registry::{DimRange, ParamInfo, SAMPLERS, SamplerInfo, build, build_nearest, find};
+pub use sobol::Sobol;
+pub use umj::Umj;
+
+use rayon::prelude::*;
+
+use crate::points::PointSet;
+use crate::rng::{SetRng, set_rng};
+
+/// A point-set generator: N points in d dimensions per call.
+pub trait Sampler: Send + Sync {
+    /// Dimension d of every set.
+    fn dim(&self) -> usize;
+    /// Number of points N of every set.
+    fn len(&self) -> usize;
+    /// Draws one realization from `rng`.
+    ///
+    /// # Errors
+    /// Only samplers that can fail to place N points (Poisson disk) do.
+    fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError>;
+}
+
+/// What is wrong with a sampler request.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SamplerError {
+    /// No sampler has this name.
+    #[error("unknown sampler `{name}`; known samplers: {known}")]
+    Unknown {
+        /// The name given.
+        name: String,
+        /// Every known name.
+        known: String,
+    },
+    /// N = 0.
+    #[error("{sampler}: the number of points must be at least 1")]
+    ZeroPoints {
+        /// Sampler name.
+        sampler: &'static str,
+    },
+    /// A dimension the sampler does not support.
+    #[error("{sampler}: dimension {dim} is not supported (supported: {min} to {max})")]
+    Dimension {
+        /// Sampler name.
+        sampler: &'static str,
+        /// Requested dimension.
+        dim: usize,
+        /// Smallest supported.
+        min: usize,
+        /// Largest supported.
+        max: usize,
+    },
+    /// N does not fit the sampler's structure.
+    #[error("{sampler}: N = {n} does not fit ({rule}); nearest valid N: {}", nearest(*below, *above))]
+    Count {
+        /// Sampler name.
+        sampler: &'static str,
+        /// Requested N.
+        n: usize,
+        /// The constraint.
+        rule: &'static str,
+        /// Largest valid N below, if any.
+        below: Option<usize>,
+        /// Smallest valid N above, if any.
+        above: Option<usize>,
+    },
+    /// N·d is too large to hold.
+    #[error(
+        "{sampler}: {n} points in {dim} dimensions is more than this tool holds (at most 2^32 coordinates)"
+    )]
+    TooLarge {
+        /// Sampler name.
+        sampler: &'static str,
+        /// Requested N.
+        n: usize,
+        /// Requested d.
+        dim: usize,
+    },
+    /// A parameter the sampler does not have.
+    #[error("{sampler}: unknown parameter `{key}`; its parameters: {known}")]
+    UnknownParam {
+        /// Sampler name.
+        sampler: &'static str,
+        /// The key given.
+        key: String,
+        /// The sampler's keys.
+        known: String,
+    },
+    /// A parameter value out of its domain.
+    #[error("{sampler}: parameter {key}={value} is invalid: expected {expected}")]
+    Param {
+        /// Sampler name.
+        sampler: &'static str,
+        /// The key.
+        key: &'static str,
+        /// The value given.
+        value: String,
+        /// What is accepted.
+        expected: String,
+    },
+    /// Dart throwing could not place N points.
+    #[error(
+        "poisson-disk: placed only {placed} of {n} points after {trials} dart throws at relative radius {rho} \
+         (random sequential dart throwing jams near 0.78 in 2D, 0.80 in 3D and 4D): lower --param radius=... \
+         or raise --param max-trials=..."
+    )]
+    Jammed {
+        /// Points placed.
+        placed: usize,
+        /// Points requested.
+        n: usize,
+        /// Throws made.
+        trials: u64,
+        /// Relative radius ρ.
+        rho: f64,
+    },
+}
+
+fn nearest(below: Option<usize>, above: Option<usize>) -> String {
+    match (below, above) {
+        (Some(b), Some(a)) => format!("{b} or {a}"),
+        (Some(b), None) => b.to_string(),
+        (None, Some(a)) => a.to_string(),
+        (None, None) => "none".to_string(),
+    }
+}
+
+/// Draws `sets` realizations of `sampler` in parallel; realization r uses
+/// the stream [`set_rng`]`(seed, r)`. `on_set_done` is called once per
+/// finished set (for progress display).
+///
+/// # Errors
+/// The first failing realization's error, in realization order.
+pub fn generate_sets(
+    sampler: &dyn Sampler,
+    seed: u64,
+    sets: usize,
+    on_set_done: &(dyn Fn() + Sync),
+) -> Result<Vec<PointSet>, SamplerError> {
+    (0..sets as u64)
+        .into_par_iter()
+        .map(|r| {
+            let set = sampler.sample(&mut set_rng(seed, r));
+            on_set_done();
+            set
+        })
+        .collect()
+}

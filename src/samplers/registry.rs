@@ -1,0 +1,438 @@
+//! The sampler registry: names, aliases, supported dimensions, constraints on
+//! N and parameters of every sampler, in one table that both the command line
+//! (`varspec sample --list`) and [`build`] read.
+
+use super::{Sampler, SamplerError};
+use super::{halton, jitter, multijitter, nrooks, poisson_disk, random, sobol, umj};
+
+/// The dimensions a sampler supports and the one it uses by default.
+#[derive(Debug, Clone, Copy)]
+pub struct DimRange {
+    /// Smallest d.
+    pub min: usize,
+    /// Largest d.
+    pub max: usize,
+    /// d when none is given.
+    pub default: usize,
+}
+
+/// One `--param key=value` a sampler accepts.
+#[derive(Debug, Clone, Copy)]
+pub struct ParamInfo {
+    /// The key.
+    pub key: &'static str,
+    /// The default value, as text.
+    pub default: &'static str,
+    /// What it means.
+    pub help: &'static str,
+}
+
+/// A registered sampler.
+pub struct SamplerInfo {
+    /// Canonical name.
+    pub name: &'static str,
+    /// Other accepted names.
+    pub aliases: &'static [&'static str],
+    /// One line on what it is, with its reference.
+    pub summary: &'static str,
+    /// Supported dimensions.
+    pub dims: DimRange,
+    /// The constraint on N, in words.
+    pub count: &'static str,
+    /// Accepted parameters.
+    pub params: &'static [ParamInfo],
+    pub(super) build: fn(&Config) -> Result<Box<dyn Sampler>, SamplerError>,
+}
+
+const ANY: DimRange = DimRange {
+    min: 1,
+    max: 64,
+    default: 2,
+};
+
+/// Every sampler, in the order `--list` shows them.
+pub const SAMPLERS: &[SamplerInfo] = &[
+    SamplerInfo {
+        name: "random",
+        aliases: &[],
+        summary: "independent uniform points (white noise)",
+        dims: ANY,
+        count: "any N",
+        params: &[],
+        build: random::from_config,
+    },
+    SamplerInfo {
+        name: "regular",
+        aliases: &["grid"],
+        summary: "centres of the m^d grid cells (deterministic; randomize by shifting)",
+        dims: ANY,
+        count: "N = m^d",
+        params: &[],
+        build: jitter::regular_from_config,
+    },
+    SamplerInfo {
+        name: "jitter",
+        aliases: &["stratified"],
+        summary: "one uniform point in each of the m^d grid strata",
+        dims: ANY,
+        count: "N = m^d",
+        params: &[],
+        build: jitter::jitter_from_config,
+    },
+    SamplerInfo {
+        name: "uniform-jitter",
+        aliases: &[],
+        summary: "one random offset shared by all m^d strata (Ramamoorthi et al. 2012)",
+        dims: ANY,
+        count: "N = m^d",
+        params: &[],
+        build: jitter::uniform_jitter_from_config,
+    },
+    SamplerInfo {
+        name: "nrooks",
+        aliases: &["lhs"],
+        summary: "N-rooks / Latin hypercube: one point per 1/N interval of every axis (McKay et al. 1979)",
+        dims: ANY,
+        count: "any N",
+        params: &[],
+        build: nrooks::from_config,
+    },
+    SamplerInfo {
+        name: "multijitter",
+        aliases: &["mj"],
+        summary: "multi-jittered: jittered on an m x n grid and N-rooks (Chiu, Shirley & Wang 1994)",
+        dims: DimRange {
+            min: 2,
+            max: 2,
+            default: 2,
+        },
+        count: "any N = m*n; best when N has a divisor near sqrt(N)",
+        params: &[ParamInfo {
+            key: "m",
+            default: "auto",
+            help: "grid columns (a divisor of N); auto = largest divisor <= sqrt(N)",
+        }],
+        build: multijitter::multijitter_from_config,
+    },
+    SamplerInfo {
+        name: "cmj",
+        aliases: &[],
+        summary: "correlated multi-jittered: one shuffle shared by all columns and one by all rows (Kensler 2013)",
+        dims: DimRange {
+            min: 2,
+            max: 2,
+            default: 2,
+        },
+        count: "any N = m*n; best when N has a divisor near sqrt(N)",
+        params: &[ParamInfo {
+            key: "m",
+            default: "auto",
+            help: "grid columns (a divisor of N); auto = largest divisor <= sqrt(N)",
+        }],
+        build: multijitter::cmj_from_config,
+    },
+    SamplerInfo {
+        name: "umj",
+        aliases: &[],
+        summary: "4D (x,y,u,v): multi-jittered (x,y) and (u,v) sets paired by a random permutation",
+        dims: DimRange {
+            min: 4,
+            max: 4,
+            default: 4,
+        },
+        count: "any N = m*n; best when N has a divisor near sqrt(N)",
+        params: &[
+            ParamInfo {
+                key: "pairs",
+                default: "mj",
+                help: "2D sets to pair: mj (multijitter) or cmj (correlated multi-jitter)",
+            },
+            ParamInfo {
+                key: "m",
+                default: "auto",
+                help: "grid columns of each 2D set (a divisor of N); auto = largest divisor <= sqrt(N)",
+            },
+        ],
+        build: umj::from_config,
+    },
+    SamplerInfo {
+        name: "poisson-disk",
+        aliases: &["pd"],
+        summary: "exactly N points at least r apart (toroidal), by grid-accelerated dart throwing",
+        dims: DimRange {
+            min: 2,
+            max: 4,
+            default: 2,
+        },
+        count: "any N",
+        params: &[
+            ParamInfo {
+                key: "radius",
+                default: "0.7",
+                help: "r as a fraction of the densest-packing radius (2D: sqrt(2/(sqrt(3) N)), Lagae & Dutre 2008); jams near 0.78",
+            },
+            ParamInfo {
+                key: "max-trials",
+                default: "auto",
+                help: "dart throws before giving up; auto = max(10^7, 1000 N)",
+            },
+        ],
+        build: poisson_disk::from_config,
+    },
+    SamplerInfo {
+        name: "sobol",
+        aliases: &[],
+        summary: "Owen-scrambled Sobol' points (Joe & Kuo 2008 directions; hash-based nested uniform scrambling, Burley 2020)",
+        dims: DimRange {
+            min: 1,
+            max: sobol::MAX_DIM,
+            default: 2,
+        },
+        count: "any N <= 2^32; (0,m,2)-net in dims 0,1 when N = 2^m",
+        params: &[],
+        build: sobol::from_config,
+    },
+    SamplerInfo {
+        name: "halton",
+        aliases: &[],
+        summary: "Halton points with random digit permutations (Matousek 1998 random digit scrambling)",
+        dims: DimRange {
+            min: 1,
+            max: halton::MAX_DIM,
+            default: 2,
+        },
+        count: "any N",
+        params: &[],
+        build: halton::from_config,
+    },
+];
+
+/// A validated request, handed to a sampler's constructor.
+pub(super) struct Config {
+    pub sampler: &'static str,
+    pub n: usize,
+    pub dim: usize,
+    params: Vec<(String, String)>,
+    info: &'static SamplerInfo,
+}
+
+impl Config {
+    /// The value of `key`, or its registered default.
+    pub fn param(&self, key: &'static str) -> &str {
+        self.params
+            .iter()
+            .rev()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+            .or_else(|| {
+                self.info
+                    .params
+                    .iter()
+                    .find(|p| p.key == key)
+                    .map(|p| p.default)
+            })
+            .expect("parameter keys are registered")
+    }
+
+    /// An error for parameter `key` saying what is expected.
+    pub fn bad_param(&self, key: &'static str, expected: impl Into<String>) -> SamplerError {
+        SamplerError::Param {
+            sampler: self.sampler,
+            key,
+            value: self.param(key).to_string(),
+            expected: expected.into(),
+        }
+    }
+
+    /// An error saying N must satisfy `rule`, with the nearest valid counts.
+    pub fn bad_count(
+        &self,
+        rule: &'static str,
+        below: Option<usize>,
+        above: Option<usize>,
+    ) -> SamplerError {
+        SamplerError::Count {
+            sampler: self.sampler,
+            n: self.n,
+            rule,
+            below,
+            above,
+        }
+    }
+}
+
+/// The sampler registered under `name` or one of its aliases.
+///
+/// # Errors
+/// [`SamplerError::Unknown`] listing the known names.
+pub fn find(name: &str) -> Result<&'static SamplerInfo, SamplerError> {
+    SAMPLERS
+        .iter()
+        .find(|s| s.name == name || s.aliases.contains(&name))
+        .ok_or_else(|| SamplerError::Unknown {
+            name: name.to_string(),
+            known: SAMPLERS
+                .iter()
+                .map(|s| s.name)
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}
+
+/// Builds sampler `name` for N = `n` points in `dim` dimensions (the
+/// sampler's default when `None`) with `key=value` parameters.
+///
+/// # Errors
+/// [`SamplerError`] for an unknown name or parameter, an unsupported
+/// dimension, N = 0, an N that does not fit (naming the nearest valid N), or
+/// an invalid parameter value.
+pub fn build(
+    name: &str,
+    n: usize,
+    dim: Option<usize>,
+    params: &[(String, String)],
+) -> Result<Box<dyn Sampler>, SamplerError> {
+    let info = find(name)?;
+    let sampler = info.name;
+    let dim = dim.unwrap_or(info.dims.default);
+    if dim < info.dims.min || dim > info.dims.max {
+        return Err(SamplerError::Dimension {
+            sampler,
+            dim,
+            min: info.dims.min,
+            max: info.dims.max,
+        });
+    }
+    if n == 0 {
+        return Err(SamplerError::ZeroPoints { sampler });
+    }
+    if n.checked_mul(dim).is_none_or(|c| c > 1 << 32) {
+        return Err(SamplerError::TooLarge { sampler, n, dim });
+    }
+    if let Some((key, _)) = params
+        .iter()
+        .find(|(k, _)| !info.params.iter().any(|p| p.key == k))
+    {
+        let known = info.params.iter().map(|p| p.key).collect::<Vec<_>>();
+        return Err(SamplerError::UnknownParam {
+            sampler,
+            key: key.clone(),
+            known: if known.is_empty() {
+                "none".into()
+            } else {
+                known.join(", ")
+            },
+        });
+    }
+    let config = Config {
+        sampler,
+        n,
+        dim,
+        params: params.to_vec(),
+        info,
+    };
+    (info.build)(&config)
+}
+
+/// Like [`build`], but when N does not fit the sampler's structure, uses the
+/// nearest valid N instead (the larger one on a tie) and returns it.
+///
+/// # Errors
+/// As [`build`] for everything but the count.
+pub fn build_nearest(
+    name: &str,
+    n: usize,
+    dim: Option<usize>,
+    params: &[(String, String)],
+) -> Result<(Box<dyn Sampler>, usize), SamplerError> {
+    match build(name, n, dim, params) {
+        Err(SamplerError::Count { below, above, .. }) => {
+            let nearest = match (below, above) {
+                (Some(b), Some(a)) if n - b < a - n => b,
+                (_, Some(a)) => a,
+                (Some(b), None) => b,
+                (None, None) => n,
+            };
+            build(name, nearest, dim, params).map(|s| (s, nearest))
+        }
+        other => other.map(|s| (s, n)),
+    }
+}
+
+/// The integer `⌊n^(1/d)⌋`, exactly.
+pub(super) fn integer_root(n: usize, d: usize) -> usize {
+    let fits = |m: usize| m.checked_pow(d as u32).is_some_and(|p| p <= n);
+    let mut m = (n as f64).powf(1.0 / d as f64).round() as usize;
+    while m > 0 && !fits(m) {
+        m -= 1;
+    }
+    while fits(m + 1) {
+        m += 1;
+    }
+    m
+}
+
+/// `m^d`, saturating at `usize::MAX`.
+pub(super) fn pow_saturating(m: usize, d: usize) -> usize {
+    m.checked_pow(d as u32).unwrap_or(usize::MAX)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integer_root_is_exact() {
+        assert_eq!(integer_root(1, 2), 1);
+        assert_eq!(integer_root(99, 2), 9);
+        assert_eq!(integer_root(100, 2), 10);
+        assert_eq!(integer_root(124, 3), 4);
+        assert_eq!(integer_root(125, 3), 5);
+        assert_eq!(integer_root(usize::MAX, 2), 4_294_967_295);
+    }
+
+    #[test]
+    fn names_and_aliases_are_unique() {
+        let mut all: Vec<&str> = SAMPLERS
+            .iter()
+            .flat_map(|s| std::iter::once(s.name).chain(s.aliases.iter().copied()))
+            .collect();
+        let count = all.len();
+        all.sort_unstable();
+        all.dedup();
+        assert_eq!(all.len(), count);
+    }
+
+    #[test]
+    fn request_errors_are_specific() {
+        assert!(matches!(
+            build("nope", 4, None, &[]),
+            Err(SamplerError::Unknown { .. })
+        ));
+        assert!(matches!(
+            build("random", 0, None, &[]),
+            Err(SamplerError::ZeroPoints { .. })
+        ));
+        assert!(matches!(
+            build("cmj", 16, Some(3), &[]),
+            Err(SamplerError::Dimension { dim: 3, .. })
+        ));
+        let p = vec![("radius".to_string(), "0.5".to_string())];
+        assert!(matches!(
+            build("random", 4, None, &p),
+            Err(SamplerError::UnknownParam { .. })
+        ));
+        let e = build("jitter", 1000, None, &[]).err().unwrap();
+        assert_eq!(
+            e,
+            SamplerError::Count {
+                sampler: "jitter",
+                n: 1000,
+                rule: "N = m^d",
+                below: Some(961),
+                above: Some(1024)
+            }
+        );
+        assert!(e.to_string().contains("961 or 1024"), "{e}");
+    }
+}

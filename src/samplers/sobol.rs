@@ -1,0 +1,165 @@
+//! Owen-scrambled Sobol' points.
+//!
+//! The first N points of the Sobol' sequence (Sobol' 1967; direction numbers
+//! of Joe & Kuo 2008, see [`super::sobol_table`]), each dimension scrambled
+//! by a nested uniform (Owen 1995) scramble realized with Burley's hash-based
+//! Laine–Karras permutation (B. Burley 2020, "Practical hash-based Owen
+//! scrambling", JCGT 9(4)): reverse the bits, apply a per-dimension seeded
+//! hash in which each output bit depends only on lower input bits, reverse
+//! back. Scrambling keeps the net structure: for N = 2^m the first two
+//! dimensions form a (0, m, 2)-net. Below the 32 scrambled bits, 21 uniform
+//! bits complete the f64 mantissa so every coordinate is uniform on [0,1).
+
+use super::registry::Config;
+use super::sobol_table::JOE_KUO;
+use super::{Sampler, SamplerError};
+use crate::points::PointSet;
+use crate::rng::{SetRng, uniform};
+use rand::Rng;
+
+/// Dimensions with tabulated direction numbers.
+pub const MAX_DIM: usize = JOE_KUO.len() + 1;
+
+const BITS: usize = 32;
+
+/// Owen-scrambled Sobol' points: N ≤ 2^32 in d ≤ [`MAX_DIM`] dimensions.
+#[derive(Debug, Clone)]
+pub struct Sobol {
+    n: usize,
+    /// 32 direction numbers per dimension, v_k = m_k · 2^(32−k).
+    directions: Vec<[u32; BITS]>,
+}
+
+impl Sobol {
+    /// The first N points in d dimensions.
+    ///
+    /// # Panics
+    /// If d > [`MAX_DIM`] or N > 2^32 (the registry refuses both first).
+    pub fn new(n: usize, dim: usize) -> Self {
+        assert!(dim <= MAX_DIM && (n as u64) <= 1 << 32);
+        Sobol {
+            n,
+            directions: (0..dim).map(direction_numbers).collect(),
+        }
+    }
+}
+
+/// Direction numbers of dimension `j` (0-based) by the recurrence
+/// m_k = 2a_1 m_(k−1) ⊕ 2²a_2 m_(k−2) ⊕ … ⊕ 2^s m_(k−s) ⊕ m_(k−s)
+/// (Bratley & Fox 1988, Eq. (1); Joe & Kuo 2008 §2).
+fn direction_numbers(j: usize) -> [u32; BITS] {
+    let mut m = [1u64; BITS];
+    if j > 0 {
+        let (s, a, init) = JOE_KUO[j - 1];
+        let s = s as usize;
+        for (k, &mk) in init.iter().enumerate() {
+            m[k] = mk as u64;
+        }
+        for k in s..BITS {
+            let mut next = m[k - s] ^ (m[k - s] << s);
+            for i in 1..s {
+                let a_i = (a >> (s - 1 - i)) & 1;
+                if a_i == 1 {
+                    next ^= m[k - i] << i;
+                }
+            }
+            m[k] = next;
+        }
+    }
+    std::array::from_fn(|k| (m[k] << (BITS - 1 - k)) as u32)
+}
+
+/// Burley's Laine–Karras-style hash: a bijection of u32 in which output bit
+/// b depends only on input bits ≤ b (JCGT 9(4), listing 2 constants).
+#[inline]
+fn laine_karras(mut x: u32, seed: u32) -> u32 {
+    x = x.wrapping_add(seed);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x
+}
+
+/// Nested uniform scramble of the binary fraction x·2⁻³², seeded.
+#[inline]
+fn owen_scramble(x: u32, seed: u32) -> u32 {
+    laine_karras(x.reverse_bits(), seed).reverse_bits()
+}
+
+pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+    if c.n as u64 > 1 << 32 {
+        return Err(c.bad_count("N <= 2^32", Some(1 << 32), None));
+    }
+    Ok(Box::new(Sobol::new(c.n, c.dim)))
+}
+
+impl Sampler for Sobol {
+    fn dim(&self) -> usize {
+        self.directions.len()
+    }
+
+    fn len(&self) -> usize {
+        self.n
+    }
+
+    fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError> {
+        let d = self.directions.len();
+        let seeds: Vec<u32> = (0..d).map(|_| rng.next_u32()).collect();
+        let mut coords = Vec::with_capacity(self.n * d);
+        for i in 0..self.n as u64 {
+            for (v, &seed) in self.directions.iter().zip(&seeds) {
+                let mut x = 0u32;
+                let mut bits = i;
+                let mut k = 0;
+                while bits != 0 {
+                    if bits & 1 == 1 {
+                        x ^= v[k];
+                    }
+                    bits >>= 1;
+                    k += 1;
+                }
+                let scrambled = owen_scramble(x, seed) as f64;
+                // 21 uniform bits below the 32 scrambled ones: exact in f64, < 1.
+                let tail = (uniform(rng) * (1u64 << 21) as f64).floor() / (1u64 << 21) as f64;
+                coords.push((scrambled + tail) * (1.0 / (1u64 << 32) as f64));
+            }
+        }
+        Ok(PointSet::new(d, coords).expect("scrambled fractions lie in [0,1)"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_dimensions_are_van_der_corput_and_its_companion() {
+        // Unscrambled dimension 0 is the van der Corput sequence; dimension 1
+        // (x+1, m_k = 1) gives 1/2, 3/4, 1/4 for i = 1, 2, 3 (Bratley & Fox 1988).
+        let s = Sobol::new(4, 2);
+        let point = |i: u64, j: usize| {
+            (0..32)
+                .filter(|k| i >> k & 1 == 1)
+                .fold(0u32, |x, k| x ^ s.directions[j][k]) as f64
+                / 2f64.powi(32)
+        };
+        assert_eq!([point(1, 0), point(2, 0), point(3, 0)], [0.5, 0.25, 0.75]);
+        assert_eq!([point(1, 1), point(2, 1), point(3, 1)], [0.5, 0.75, 0.25]);
+    }
+
+    #[test]
+    fn scramble_is_nested() {
+        // Output bit b (from the top) depends only on input bits above it: two
+        // inputs that share their top t bits share the top t output bits.
+        for seed in [0u32, 1, 0xdead_beef] {
+            for t in 1..32 {
+                let a = 0x9e37_79b9u32;
+                let b = a ^ (1u32 << (31 - t)); // differs first at bit t from the top
+                let (sa, sb) = (owen_scramble(a, seed), owen_scramble(b, seed));
+                assert_eq!(sa >> (32 - t), sb >> (32 - t), "seed {seed}, t {t}");
+                assert_ne!(sa >> (31 - t), sb >> (31 - t), "bijective at bit {t}");
+            }
+        }
+    }
+}
