@@ -107,7 +107,11 @@ mod tests {
             assert!((0.0..1.0).contains(&u));
             assert!(below(&mut rng, 7) < 7);
         }
-        assert!(PREV_ONE < 1.0 && PREV_ONE + f64::EPSILON / 2.0 == 1.0);
+        assert_eq!(
+            PREV_ONE.to_bits() + 1,
+            1f64.to_bits(),
+            "PREV_ONE is the double just below 1"
+        );
     }
 
     #[test]

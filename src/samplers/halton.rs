@@ -93,7 +93,7 @@ impl Sampler for Halton {
         self.dim
     }
 
-    fn len(&self) -> usize {
+    fn points_per_set(&self) -> usize {
         self.n
     }
 

@@ -72,7 +72,7 @@ impl Sampler for Jitter {
         self.dim
     }
 
-    fn len(&self) -> usize {
+    fn points_per_set(&self) -> usize {
         pow_saturating(self.m, self.dim)
     }
 
@@ -82,7 +82,7 @@ impl Sampler for Jitter {
             StratumOffset::Shared => (0..d).map(|_| uniform(rng)).collect(),
             _ => vec![0.5; d],
         };
-        let n = self.len();
+        let n = self.points_per_set();
         let mut coords = Vec::with_capacity(n * d);
         // Point i sits in the stratum whose base-m digits are i's: digit j
         // (least significant first) is its cell index along axis j.

@@ -37,7 +37,7 @@ pub trait Sampler: Send + Sync {
     /// Dimension d of every set.
     fn dim(&self) -> usize;
     /// Number of points N of every set.
-    fn len(&self) -> usize;
+    fn points_per_set(&self) -> usize;
     /// Draws one realization from `rng`.
     ///
     /// # Errors

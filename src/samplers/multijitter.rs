@@ -103,12 +103,12 @@ impl Sampler for MultiJitter {
         2
     }
 
-    fn len(&self) -> usize {
+    fn points_per_set(&self) -> usize {
         self.columns * self.rows
     }
 
     fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError> {
-        let mut coords = vec![0.0; 2 * self.len()];
+        let mut coords = vec![0.0; 2 * self.points_per_set()];
         self.fill(rng, &mut coords);
         Ok(PointSet::new(2, coords).expect("stratum coordinates lie in [0,1)"))
     }

@@ -31,7 +31,7 @@ impl Sampler for NRooks {
         self.dim
     }
 
-    fn len(&self) -> usize {
+    fn points_per_set(&self) -> usize {
         self.n
     }
 

@@ -106,7 +106,7 @@ impl Sampler for PoissonDisk {
         self.dim
     }
 
-    fn len(&self) -> usize {
+    fn points_per_set(&self) -> usize {
         self.n
     }
 

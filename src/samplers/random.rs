@@ -29,7 +29,7 @@ impl Sampler for Random {
         self.dim
     }
 
-    fn len(&self) -> usize {
+    fn points_per_set(&self) -> usize {
         self.n
     }
 

@@ -99,7 +99,7 @@ impl Sampler for Sobol {
         self.directions.len()
     }
 
-    fn len(&self) -> usize {
+    fn points_per_set(&self) -> usize {
         self.n
     }
 

@@ -21,7 +21,7 @@ pub struct Umj {
 impl Umj {
     /// N = m·n points whose (x,y) and (u,v) are each `pairs` sets.
     pub fn new(pairs: MultiJitter) -> Self {
-        let n = pairs.len();
+        let n = pairs.points_per_set();
         Umj { pairs, n }
     }
 }
@@ -41,7 +41,7 @@ impl Sampler for Umj {
         4
     }
 
-    fn len(&self) -> usize {
+    fn points_per_set(&self) -> usize {
         self.n
     }
 

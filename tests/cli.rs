@@ -1,0 +1,255 @@
+//! The command line as scripts use it: determinism across thread counts,
+//! exit codes and messages on bad input, the sampler list, pictures.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn varspec(args: &[&str], threads: Option<&str>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_varspec"));
+    cmd.args(args);
+    if let Some(t) = threads {
+        cmd.env("RAYON_NUM_THREADS", t);
+    }
+    cmd.output().expect("the varspec binary runs")
+}
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("varspec-cli-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn same_seed_gives_identical_bytes_on_one_and_two_threads() {
+    for (sampler, n, extra) in [
+        ("random", "100", vec![]),
+        ("jitter", "64", vec![]),
+        ("cmj", "60", vec![]),
+        ("umj", "64", vec![]),
+        ("poisson-disk", "200", vec!["-d", "3"]),
+        ("sobol", "128", vec![]),
+        ("halton", "50", vec![]),
+        ("nrooks", "33", vec!["-d", "4"]),
+    ] {
+        let mut args = vec!["sample", sampler, "-n", n, "--sets", "16", "--seed", "42"];
+        args.extend(extra);
+        let one = varspec(&args, Some("1"));
+        let two = varspec(&args, Some("2"));
+        assert!(
+            one.status.success(),
+            "{sampler}: {}",
+            String::from_utf8_lossy(&one.stderr)
+        );
+        assert!(
+            one.stdout == two.stdout,
+            "{sampler}: output differs between 1 and 2 threads"
+        );
+        assert!(
+            one.stderr.is_empty(),
+            "{sampler}: no progress bar off a terminal"
+        );
+        let other_seed = varspec(
+            &["sample", sampler, "-n", n, "--sets", "16", "--seed", "43"],
+            Some("2"),
+        );
+        assert!(one.stdout != other_seed.stdout, "{sampler}: seed ignored");
+    }
+}
+
+#[test]
+fn output_file_matches_stdout_and_reads_back() {
+    let dir = temp_dir("out");
+    let path = dir.join("j.csv");
+    let file_run = varspec(
+        &[
+            "sample",
+            "jitter",
+            "-n",
+            "16",
+            "--sets",
+            "3",
+            "-o",
+            path.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(file_run.status.success());
+    let stdout_run = varspec(&["sample", "jitter", "-n", "16", "--sets", "3"], None);
+    assert_eq!(std::fs::read(&path).unwrap(), stdout_run.stdout);
+    let sets = varspec::io::read_point_sets(&path).unwrap();
+    assert_eq!((sets.len(), sets[0].len(), sets[0].dim()), (3, 16, 2));
+    let utk = varspec(&["sample", "sobol", "-n", "8", "--format", "utk"], None);
+    let text = String::from_utf8(utk.stdout).unwrap();
+    assert_eq!(text.lines().count(), 8);
+    assert!(text.lines().all(|l| l.split(' ').count() == 2));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_requests_fail_with_a_specific_message() {
+    for (args, phrase) in [
+        (
+            vec!["sample", "jitter", "-n", "1000"],
+            "nearest valid N: 961 or 1024",
+        ),
+        (vec!["sample", "jitter", "-n", "30", "-d", "3"], "27 or 64"),
+        (vec!["sample", "nope", "-n", "10"], "known samplers: random"),
+        (
+            vec!["sample", "cmj", "-n", "10", "-d", "3"],
+            "dimension 3 is not supported",
+        ),
+        (vec!["sample", "random", "-n", "0"], "at least 1"),
+        (
+            vec!["sample", "random", "-n", "10", "--param", "radius=2"],
+            "unknown parameter `radius`",
+        ),
+        (
+            vec![
+                "sample",
+                "poisson-disk",
+                "-n",
+                "10",
+                "--param",
+                "radius=1.5",
+            ],
+            "radius=1.5 is invalid",
+        ),
+        (
+            vec!["sample", "multijitter", "-n", "10", "--param", "m=3"],
+            "a divisor of N = 10",
+        ),
+        (
+            vec!["sample", "random", "-n", "10", "--param", "novalue"],
+            "key=value",
+        ),
+        (
+            vec![
+                "sample",
+                "random",
+                "-n",
+                "4",
+                "-o",
+                "/nonexistent-dir/x.csv",
+            ],
+            "/nonexistent-dir/x.csv",
+        ),
+    ] {
+        let out = varspec(&args, None);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(
+            err.contains(phrase),
+            "{args:?}: {err:?} should contain {phrase:?}"
+        );
+        assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    }
+}
+
+#[test]
+fn list_names_every_sampler_with_constraints() {
+    let out = varspec(&["sample", "--list"], None);
+    let text = String::from_utf8(out.stdout).unwrap();
+    for info in varspec::samplers::SAMPLERS {
+        assert!(
+            text.contains(info.name) && text.contains(info.count),
+            "{} missing from --list",
+            info.name
+        );
+        for p in info.params {
+            assert!(text.contains(&format!("--param {}=", p.key)));
+        }
+    }
+}
+
+#[test]
+fn plot_draws_a_projection_and_reports_bad_files_by_line() {
+    let dir = temp_dir("plot");
+    let points = dir.join("umj.csv");
+    let png = dir.join("xu.png");
+    assert!(
+        varspec(
+            &["sample", "umj", "-n", "64", "-o", points.to_str().unwrap()],
+            None
+        )
+        .status
+        .success()
+    );
+    let out = varspec(
+        &[
+            "plot",
+            "points",
+            points.to_str().unwrap(),
+            "--dims",
+            "0,2",
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (512, 512));
+    let bad_dims = varspec(
+        &[
+            "plot",
+            "points",
+            points.to_str().unwrap(),
+            "--dims",
+            "0,4",
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(String::from_utf8_lossy(&bad_dims.stderr).contains("out of range"));
+    let broken = dir.join("broken.csv");
+    std::fs::write(&broken, "x0,x1\n0.5,0.5\n0.5,1.5\n").unwrap();
+    let out = varspec(
+        &[
+            "plot",
+            "points",
+            broken.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        None,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("broken.csv:3:") && err.contains("1.5"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn compare_writes_a_table_and_pictures() {
+    let dir = temp_dir("compare");
+    let out = varspec(
+        &[
+            "compare",
+            "-n",
+            "100",
+            "--sets",
+            "2",
+            "-o",
+            dir.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8(out.stdout).unwrap();
+    assert!(table.contains("poisson-disk") && table.contains("sobol"));
+    let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+    assert_eq!(summary.lines().count(), 11);
+    assert!(dir.join("cmj.png").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,210 @@
+//! Structural properties of every sampler (STYLE.md §7): strata, N-rooks
+//! intervals, Poisson-disk distances, net intervals; checked on random seeds
+//! and sizes by proptest.
+
+use proptest::prelude::*;
+use std::collections::HashSet;
+use varspec::PointSet;
+use varspec::points::toroidal_distance_sq;
+use varspec::rng::set_rng;
+use varspec::samplers::{self, packing_radius};
+
+fn draw(name: &str, n: usize, dim: usize, params: &[(&str, &str)], seed: u64) -> PointSet {
+    let params: Vec<(String, String)> = params
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let sampler = samplers::build(name, n, Some(dim), &params).unwrap();
+    let set = sampler.sample(&mut set_rng(seed, 0)).unwrap();
+    assert_eq!((set.len(), set.dim()), (n, dim), "{name}: wrong shape");
+    set
+}
+
+/// Cell of coordinate x on a grid of `cells` intervals.
+fn cell(x: f64, cells: usize) -> usize {
+    (x * cells as f64) as usize
+}
+
+/// Every point in its own cell of the grid with `cells[j]` intervals along
+/// dimension `dims[j]`.
+fn one_per_cell(set: &PointSet, dims: &[usize], cells: &[usize]) -> bool {
+    let expected: usize = cells.iter().product();
+    let occupied: HashSet<Vec<usize>> = set
+        .points()
+        .map(|p| {
+            dims.iter()
+                .zip(cells)
+                .map(|(&j, &c)| cell(p[j], c))
+                .collect()
+        })
+        .collect();
+    occupied.len() == set.len() && set.len() == expected
+}
+
+/// One point per 1/N interval along dimension j.
+fn latin(set: &PointSet, j: usize) -> bool {
+    one_per_cell(set, &[j], &[set.len()])
+}
+
+/// The multi-jitter grid: m = largest divisor of N not above √N.
+fn grid(n: usize) -> (usize, usize) {
+    let m = (1..=n).filter(|m| m * m <= n && n % m == 0).max().unwrap();
+    (m, n / m)
+}
+
+fn is_multijittered(set: &PointSet, x: usize, y: usize) -> bool {
+    let (m, n) = grid(set.len());
+    one_per_cell(set, &[x, y], &[m, n]) && latin(set, x) && latin(set, y)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn jitter_has_one_point_per_stratum(seed: u64, m in 1usize..12, d in 1usize..4) {
+        let n = m.pow(d as u32);
+        let set = draw("jitter", n, d, &[], seed);
+        prop_assert!(one_per_cell(&set, &(0..d).collect::<Vec<_>>(), &vec![m; d]));
+    }
+
+    #[test]
+    fn uniform_jitter_shares_one_offset(seed: u64, m in 1usize..12, d in 1usize..4) {
+        let n = m.pow(d as u32);
+        let set = draw("uniform-jitter", n, d, &[], seed);
+        prop_assert!(one_per_cell(&set, &(0..d).collect::<Vec<_>>(), &vec![m; d]));
+        for j in 0..d {
+            let offset = |p: &[f64]| p[j] * m as f64 - cell(p[j], m) as f64;
+            let first = offset(set.point(0));
+            prop_assert!(set.points().all(|p| (offset(p) - first).abs() < 1e-9));
+        }
+    }
+
+    #[test]
+    fn regular_is_the_grid_of_cell_centres(m in 1usize..20) {
+        let set = draw("regular", m * m, 2, &[], 0);
+        for p in set.points() {
+            for &x in p {
+                let k = x * m as f64 - 0.5;
+                prop_assert!((k - k.round()).abs() < 1e-9, "{x} is not a cell centre of {m}");
+            }
+        }
+        prop_assert!(one_per_cell(&set, &[0, 1], &[m, m]));
+    }
+
+    #[test]
+    fn nrooks_is_latin_in_every_dimension(seed: u64, n in 1usize..300, d in 1usize..6) {
+        let set = draw("lhs", n, d, &[], seed);
+        for j in 0..d {
+            prop_assert!(latin(&set, j), "dimension {j}");
+        }
+    }
+
+    #[test]
+    fn multijitter_is_jittered_and_latin(seed: u64, n in 1usize..400) {
+        prop_assert!(is_multijittered(&draw("multijitter", n, 2, &[], seed), 0, 1));
+    }
+
+    #[test]
+    fn cmj_is_jittered_latin_and_correlated(seed: u64, n in 1usize..400) {
+        let set = draw("cmj", n, 2, &[], seed);
+        prop_assert!(is_multijittered(&set, 0, 1));
+        // Correlation (Kensler 2013): the fine x offset σ(j) of the point in
+        // row j is the same in every column.
+        let (m, rows) = grid(n);
+        let mut sigma = vec![None; rows];
+        for p in set.points() {
+            let (i, j) = (cell(p[0], m), cell(p[1], rows));
+            let s = cell(p[0], n) - i * rows;
+            prop_assert!(*sigma[j].get_or_insert(s) == s, "row {j} shuffled differently across columns");
+        }
+    }
+
+    #[test]
+    fn umj_pairs_are_each_multijittered(seed: u64, n in 1usize..300, cmj: bool) {
+        let set = draw("umj", n, 4, &[("pairs", if cmj { "cmj" } else { "mj" })], seed);
+        prop_assert!(is_multijittered(&set, 0, 1));
+        prop_assert!(is_multijittered(&set, 2, 3));
+    }
+
+    #[test]
+    fn poisson_disk_keeps_its_minimum_distance(seed: u64, n in 1usize..400, d in 2usize..5, rho in 0.3f64..0.75) {
+        let rho_text = rho.to_string();
+        let set = draw("poisson-disk", n, d, &[("radius", &rho_text)], seed);
+        let r2 = (rho * packing_radius(n, d)).powi(2);
+        for i in 0..n {
+            for k in 0..i {
+                let d2 = toroidal_distance_sq(set.point(i), set.point(k));
+                prop_assert!(d2 >= r2, "points {i} and {k} at {} < r = {}", d2.sqrt(), r2.sqrt());
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_first_two_dimensions_are_a_0_m_2_net(seed: u64, m in 0u32..13, d in 2usize..6) {
+        let n = 1usize << m;
+        let set = draw("sobol", n, d, &[], seed);
+        for a in 0..=m {
+            let (cx, cy) = (1usize << a, 1usize << (m - a));
+            prop_assert!(one_per_cell(&set, &[0, 1], &[cx, cy]), "elementary intervals {cx} x {cy}");
+        }
+    }
+
+    #[test]
+    fn halton_is_stratified_in_its_bases(seed: u64, a in 0u32..6, b in 0u32..4) {
+        let n = 2usize.pow(a) * 3usize.pow(b);
+        let set = draw("halton", n, 3, &[], seed);
+        prop_assert!(one_per_cell(&set, &[0, 1], &[2usize.pow(a), 3usize.pow(b)]));
+        prop_assert!(latin(&draw("halton", 2usize.pow(a), 1, &[], seed), 0));
+    }
+}
+
+#[test]
+fn every_registered_sampler_stays_on_the_torus() {
+    // PointSet::new validates [0,1) and finiteness; this drives every sampler
+    // through it at an awkward N and the extreme PREV_ONE rounding.
+    for info in samplers::SAMPLERS {
+        let d = info.dims.default;
+        let (sampler, n) = samplers::build_nearest(info.name, 97, Some(d), &[]).unwrap();
+        for seed in 0..20 {
+            let set = sampler.sample(&mut set_rng(seed, 3)).unwrap();
+            assert_eq!(set.len(), n, "{}", info.name);
+            assert!(
+                set.coords().iter().all(|x| (0.0..1.0).contains(x)),
+                "{}",
+                info.name
+            );
+        }
+    }
+}
+
+#[test]
+fn poisson_disk_reports_jamming_instead_of_looping() {
+    let params = [
+        ("radius".to_string(), "0.95".to_string()),
+        ("max-trials".to_string(), "100000".to_string()),
+    ];
+    let sampler = samplers::build("poisson-disk", 500, Some(2), &params).unwrap();
+    let err = sampler.sample(&mut set_rng(1, 0)).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        matches!(
+            err,
+            samplers::SamplerError::Jammed {
+                n: 500,
+                trials: 100000,
+                ..
+            }
+        ),
+        "{text}"
+    );
+    assert!(
+        text.contains("of 500 points") && text.contains("radius"),
+        "{text}"
+    );
+}
+
+#[test]
+fn poisson_disk_in_3d_reaches_its_count_at_default_radius() {
+    let set = draw("poisson-disk", 2000, 3, &[], 5);
+    assert_eq!(set.len(), 2000);
+}
