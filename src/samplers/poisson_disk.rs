@@ -1,8 +1,8 @@
 //! Poisson-disk sampling by random sequential dart throwing: uniform
 //! candidates are accepted when no accepted point lies within toroidal
-//! distance r, until exactly N points are placed. A background grid whose
-//! cells have diagonal ≤ r holds at most one point per cell, so each
-//! candidate is checked against the (2k+1)^d cells within reach only.
+//! distance r, until exactly N points are placed. Accepted points are binned
+//! in a grid of cells of side ≥ r (linked lists per cell), so a candidate is
+//! checked against the 3^d cells around its own only.
 //!
 //! The radius is relative to the densest packing (Lagae & Dutré 2008, "A
 //! comparison of methods for generating Poisson disk distributions",
@@ -62,9 +62,9 @@ impl PoissonDisk {
         self.rho * packing_radius(self.n, self.dim)
     }
 
-    /// Cells per axis: the fewest with diagonal √d/g ≤ r.
+    /// Cells per axis: the most whose side 1/g is still ≥ r.
     fn cells_per_axis(&self) -> usize {
-        ((self.dim as f64).sqrt() / self.radius()).ceil().max(1.0) as usize
+        ((1.0 / self.radius()).floor() as usize).max(1)
     }
 }
 
@@ -99,7 +99,7 @@ pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> 
     Ok(Box::new(sampler))
 }
 
-const EMPTY: u32 = u32::MAX;
+const NONE: u32 = u32::MAX;
 
 impl Sampler for PoissonDisk {
     fn dim(&self) -> usize {
@@ -112,20 +112,22 @@ impl Sampler for PoissonDisk {
 
     fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError> {
         let (n, d) = (self.n, self.dim);
-        let r = self.radius();
-        let r2 = r * r;
+        let r2 = self.radius().powi(2);
         let g = self.cells_per_axis();
-        let reach = (r * g as f64).ceil() as isize;
-        let offsets = neighbourhood(d, reach);
-        let mut grid = vec![EMPTY; pow_saturating(g, d)];
+        // Side ≥ r: every conflict lies in the 3^d cells around the
+        // candidate's (fewer when g < 3, so no cell is visited twice).
+        let offsets = neighbourhood(d, g.min(3));
+        // head[c] is the last point binned in cell c, next[i] the one before i.
+        let mut head = vec![NONE; pow_saturating(g, d)];
+        let mut next: Vec<u32> = Vec::with_capacity(n);
         let mut coords: Vec<f64> = Vec::with_capacity(n * d);
         let mut candidate = vec![0.0; d];
         let mut cell = vec![0isize; d];
         let mut trials = 0u64;
-        while coords.len() < n * d {
+        while next.len() < n {
             if trials == self.max_trials {
                 return Err(SamplerError::Jammed {
-                    placed: coords.len() / d,
+                    placed: next.len(),
                     n,
                     trials,
                     rho: self.rho,
@@ -136,20 +138,24 @@ impl Sampler for PoissonDisk {
                 candidate[j] = uniform(rng);
                 cell[j] = ((candidate[j] * g as f64) as isize).min(g as isize - 1);
             }
-            let home = cell
-                .iter()
-                .rev()
-                .fold(0usize, |acc, &c| acc * g + c as usize);
-            if grid[home] != EMPTY {
-                continue;
-            }
             let clear = offsets.chunks_exact(d).all(|o| {
-                let other = grid[cell_index(&cell, o, g)];
-                other == EMPTY
-                    || toroidal_distance_sq(&candidate, &coords[other as usize * d..][..d]) >= r2
+                let mut other = head[cell_index(&cell, o, g)];
+                while other != NONE {
+                    let i = other as usize;
+                    if toroidal_distance_sq(&candidate, &coords[i * d..(i + 1) * d]) < r2 {
+                        return false;
+                    }
+                    other = next[i];
+                }
+                true
             });
             if clear {
-                grid[home] = (coords.len() / d) as u32;
+                let home = cell
+                    .iter()
+                    .rev()
+                    .fold(0usize, |acc, &c| acc * g + c as usize);
+                next.push(head[home]);
+                head[home] = (next.len() - 1) as u32;
                 coords.extend_from_slice(&candidate);
             }
         }
@@ -157,15 +163,15 @@ impl Sampler for PoissonDisk {
     }
 }
 
-/// All offsets in {−reach..reach}^d, flattened.
-fn neighbourhood(d: usize, reach: isize) -> Vec<isize> {
-    let side = (2 * reach + 1) as usize;
+/// The offsets of a `side`^d block of cells centred on 0 (side 1, 2 or 3),
+/// flattened.
+fn neighbourhood(d: usize, side: usize) -> Vec<isize> {
     let count = pow_saturating(side, d);
     let mut out = Vec::with_capacity(count * d);
     for idx in 0..count {
         let mut rest = idx;
         for _ in 0..d {
-            out.push((rest % side) as isize - reach);
+            out.push((rest % side) as isize - (side as isize - 1) / 2);
             rest /= side;
         }
     }
@@ -175,8 +181,8 @@ fn neighbourhood(d: usize, reach: isize) -> Vec<isize> {
 /// Linear index of cell `cell + offset`, wrapped on the torus.
 #[inline]
 fn cell_index(cell: &[isize], offset: &[isize], g: usize) -> usize {
-    let g = g as isize;
+    let gi = g as isize;
     cell.iter().zip(offset).rev().fold(0usize, |acc, (c, o)| {
-        acc * g as usize + (c + o).rem_euclid(g) as usize
+        acc * g + (c + o).rem_euclid(gi) as usize
     })
 }

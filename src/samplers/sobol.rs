@@ -14,7 +14,7 @@ use super::registry::Config;
 use super::sobol_table::JOE_KUO;
 use super::{Sampler, SamplerError};
 use crate::points::PointSet;
-use crate::rng::{SetRng, uniform};
+use crate::rng::SetRng;
 use rand::Rng;
 
 /// Dimensions with tabulated direction numbers.
@@ -106,26 +106,57 @@ impl Sampler for Sobol {
     fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError> {
         let d = self.directions.len();
         let seeds: Vec<u32> = (0..d).map(|_| rng.next_u32()).collect();
+        // x_i = x_(i−1) ⊕ v_0 ⊕ … ⊕ v_c with c the trailing zeros of i (the
+        // bits that flip from i−1 to i), so prefix XORs give one XOR a step.
+        let flips: Vec<[u32; BITS]> = self
+            .directions
+            .iter()
+            .map(|v| {
+                let mut acc = 0;
+                std::array::from_fn(|k| {
+                    acc ^= v[k];
+                    acc
+                })
+            })
+            .collect();
+        let mut x = vec![0u32; d];
+        let mut tails = TailBits::default();
         let mut coords = Vec::with_capacity(self.n * d);
         for i in 0..self.n as u64 {
-            for (v, &seed) in self.directions.iter().zip(&seeds) {
-                let mut x = 0u32;
-                let mut bits = i;
-                let mut k = 0;
-                while bits != 0 {
-                    if bits & 1 == 1 {
-                        x ^= v[k];
-                    }
-                    bits >>= 1;
-                    k += 1;
+            if i > 0 {
+                let c = i.trailing_zeros() as usize;
+                for (xj, f) in x.iter_mut().zip(&flips) {
+                    *xj ^= f[c];
                 }
-                let scrambled = owen_scramble(x, seed) as f64;
-                // 21 uniform bits below the 32 scrambled ones: exact in f64, < 1.
-                let tail = (uniform(rng) * (1u64 << 21) as f64).floor() / (1u64 << 21) as f64;
-                coords.push((scrambled + tail) * (1.0 / (1u64 << 32) as f64));
+            }
+            for (&xj, &seed) in x.iter().zip(&seeds) {
+                let scrambled = owen_scramble(xj, seed) as u64;
+                // 21 uniform bits below the 32 scrambled ones: 53 bits, exact, < 1.
+                let bits = (scrambled << 21) | tails.next(rng);
+                coords.push(bits as f64 * (1.0 / (1u64 << 53) as f64));
             }
         }
         Ok(PointSet::new(d, coords).expect("scrambled fractions lie in [0,1)"))
+    }
+}
+
+/// Hands out 21-bit uniform integers, three from each 64-bit draw.
+#[derive(Default)]
+struct TailBits {
+    bits: u64,
+    left: u32,
+}
+
+impl TailBits {
+    fn next(&mut self, rng: &mut SetRng) -> u64 {
+        if self.left < 21 {
+            self.bits = rng.next_u64();
+            self.left = 64;
+        }
+        let out = self.bits & ((1 << 21) - 1);
+        self.bits >>= 21;
+        self.left -= 21;
+        out
     }
 }
 
