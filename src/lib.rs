@@ -15,6 +15,7 @@ pub mod points;
 pub mod report;
 pub mod rng;
 pub mod samplers;
+pub mod spectrum;
 
 pub use error::Error;
 pub use points::PointSet;

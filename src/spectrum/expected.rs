@@ -1,0 +1,156 @@
+//! The expected power spectrum E[N·P_S(k)] (DESIGN.md §1: "power"; white
+//! noise ≈ 1 away from DC) averaged over realizations.
+
+use rayon::prelude::*;
+use rustfft::num_complex::Complex64;
+
+use super::nufft::{NufftPlan, Sign};
+use super::{FrequencyBox, SpectrumError, dft};
+use crate::points::PointSet;
+
+/// Realizations summed per task: fixed, so the reduction order — and every
+/// output bit — is independent of the thread count.
+const CHUNK: usize = 8;
+
+/// Largest working memory a spectrum may claim.
+const MEMORY_LIMIT_MIB: u64 = 8 * 1024;
+
+/// How S(k) is computed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// Exact direct sums (the reference), O(N·K^d).
+    Direct,
+    /// Type-1 non-uniform FFT with relative tolerance ε, O(N·w^d + K^d log K).
+    Fast {
+        /// ε in [1e-14, 0.1].
+        tolerance: f64,
+    },
+}
+
+/// A power spectrum on a frequency box.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spectrum {
+    /// The frequencies, in box order.
+    pub freqs: FrequencyBox,
+    /// E[N·P_S(k)] per frequency (power; N at k = 0).
+    pub power: Vec<f64>,
+    /// Realizations averaged.
+    pub sets: usize,
+}
+
+impl Spectrum {
+    /// The power at frequency `k`.
+    ///
+    /// # Panics
+    /// If k lies outside the box.
+    pub fn at(&self, k: &[i64]) -> f64 {
+        let side = self.freqs.side() as i64;
+        let h = self.freqs.half as i64;
+        let idx = k.iter().rev().fold(0i64, |acc, &kj| {
+            assert!(kj.abs() <= h, "frequency {k:?} outside the box");
+            acc * side + kj + h
+        });
+        self.power[idx as usize]
+    }
+}
+
+/// Checks that a transform on `freqs` fits in memory: the output, and for
+/// the fast method one fine grid (2·side)^d of 2 complex buffers per thread.
+///
+/// # Errors
+/// [`SpectrumError::TooLarge`] with the estimate.
+pub fn check_memory(freqs: &FrequencyBox, method: Method, res: usize) -> Result<(), SpectrumError> {
+    let side = freqs.side() as f64;
+    let d = freqs.dim as i32;
+    let threads = rayon::current_num_threads() as f64;
+    let bytes = match method {
+        Method::Direct => side.powi(d) * (16.0 + 8.0 * threads),
+        Method::Fast { .. } => {
+            side.powi(d) * 8.0 * (threads + 1.0) + threads * 2.0 * (2.0 * side).powi(d) * 16.0
+        }
+    };
+    let needed_mib = (bytes / (1024.0 * 1024.0)).ceil() as u64;
+    if needed_mib > MEMORY_LIMIT_MIB {
+        return Err(SpectrumError::TooLarge {
+            what: "power spectrum",
+            res,
+            dim: freqs.dim,
+            needed_mib,
+            limit_mib: MEMORY_LIMIT_MIB,
+        });
+    }
+    Ok(())
+}
+
+/// E[N·P_S(k)] over `sets` realizations on the box `freqs`; realization r is
+/// `realization(r)` (a set from a file, or a fresh sampler draw), projected
+/// by the caller as needed. Parallel over realizations in fixed chunks.
+///
+/// # Errors
+/// [`SpectrumError`] for no sets, a dimension mismatch, a bad tolerance or
+/// too much memory; `realization`'s own error converted.
+pub fn expected_power<E>(
+    freqs: FrequencyBox,
+    method: Method,
+    sets: usize,
+    realization: impl Fn(usize) -> Result<PointSet, E> + Sync,
+    on_set_done: &(dyn Fn() + Sync),
+) -> Result<Spectrum, E>
+where
+    E: From<SpectrumError> + Send,
+{
+    if sets == 0 {
+        return Err(SpectrumError::NoSets.into());
+    }
+    let plan = match method {
+        Method::Fast { tolerance } => Some(NufftPlan::new(freqs, tolerance)?),
+        Method::Direct => None,
+    };
+    let len = freqs.len();
+    let chunks: Vec<Vec<f64>> = (0..sets.div_ceil(CHUNK))
+        .into_par_iter()
+        .map_init(
+            || {
+                (
+                    plan.as_ref().map(NufftPlan::make_scratch),
+                    vec![Complex64::new(0.0, 0.0); len],
+                )
+            },
+            |(scratch, s), c| -> Result<Vec<f64>, E> {
+                let mut sum = vec![0.0; len];
+                for r in c * CHUNK..((c + 1) * CHUNK).min(sets) {
+                    let points = realization(r)?;
+                    if points.dim() != freqs.dim {
+                        return Err(SpectrumError::Dimension {
+                            expected: freqs.dim,
+                            found: points.dim(),
+                        }
+                        .into());
+                    }
+                    match (&plan, scratch.as_mut()) {
+                        (Some(plan), Some(scratch)) => {
+                            plan.type1(&points, None, Sign::Negative, s, scratch)
+                        }
+                        _ => s.copy_from_slice(&dft::sample_spectrum(&points, &freqs)),
+                    }
+                    let n = points.len().max(1) as f64;
+                    for (acc, v) in sum.iter_mut().zip(s.iter()) {
+                        *acc += v.norm_sqr() / n;
+                    }
+                    on_set_done();
+                }
+                Ok(sum)
+            },
+        )
+        .collect::<Result<_, E>>()?;
+    let mut power = vec![0.0; len];
+    for chunk in &chunks {
+        for (p, v) in power.iter_mut().zip(chunk) {
+            *p += v;
+        }
+    }
+    for p in &mut power {
+        *p /= sets as f64;
+    }
+    Ok(Spectrum { freqs, power, sets })
+}

@@ -1,0 +1,60 @@
+//! Sample spectra (DESIGN.md §1): S(k) = Σ_j e^(−2πi k·x_j) on a frequency
+//! box, exactly ([`dft`]) or by non-uniform FFT ([`nufft`]); the expected
+//! power E[N·P_S(k)] over realizations ([`expected`]); radial averages and
+//! anisotropy ([`radial`]); the pair correlation function ([`pcf`]).
+
+pub mod dft;
+pub mod expected;
+pub mod frequencies;
+pub mod nufft;
+pub mod pcf;
+pub mod phase;
+pub mod radial;
+
+pub use expected::{Method, Spectrum, expected_power};
+pub use frequencies::FrequencyBox;
+pub use nufft::{NufftPlan, Sign};
+
+/// What is wrong with a spectral request.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpectrumError {
+    /// Tolerance outside what the kernel can reach.
+    #[error("tolerance {0} is outside [1e-14, 0.1]")]
+    Tolerance(f64),
+    /// The transform would need more memory than allowed.
+    #[error(
+        "a {what} of resolution {res} in {dim}D needs about {needed_mib} MiB, more than the {limit_mib} MiB allowed: lower --res"
+    )]
+    TooLarge {
+        /// What would be allocated.
+        what: &'static str,
+        /// Requested resolution K.
+        res: usize,
+        /// Dimension.
+        dim: usize,
+        /// Estimated need.
+        needed_mib: u64,
+        /// The limit.
+        limit_mib: u64,
+    },
+    /// Transforms exist for d = 1..=4.
+    #[error("spectra are computed in 1 to 4 dimensions, not {0} (project with --dims)")]
+    UnsupportedDimension(usize),
+    /// Resolution below 2.
+    #[error("resolution {0} is too small: the box |k| < K/2 needs K >= 2")]
+    Resolution(usize),
+    /// Point sets of another dimension than the transform.
+    #[error("points are {found}-dimensional, the transform is {expected}-dimensional")]
+    Dimension {
+        /// Transform dimension.
+        expected: usize,
+        /// Points' dimension.
+        found: usize,
+    },
+    /// Nothing to average.
+    #[error("no point sets to analyse")]
+    NoSets,
+    /// A bad pair-correlation parameter.
+    #[error("pair correlation: {0}")]
+    Pcf(String),
+}

@@ -1,0 +1,398 @@
+//! Non-uniform fast Fourier transforms of type 1 and type 2 in d = 1…4
+//! dimensions, one generic implementation.
+//!
+//! * Type 1 (points → modes): F(k) = Σ_j c_j e^(±2πi k·x_j) for k in a box.
+//! * Type 2 (modes → points): c_j = Σ_k F(k) e^(±2πi k·x_j).
+//!
+//! Method (Dutt & Rokhlin 1993; kernel and parameters of Barnett, Magland &
+//! af Klinteberg 2019, "A parallel non-uniform fast Fourier transform library
+//! based on an exponential of semicircle kernel", SIAM J. Sci. Comput. 41(5)):
+//! spread each point onto an oversampled periodic grid (σ = 2, n ≥ 2(2h+1))
+//! with the "exponential of semicircle" kernel
+//! ψ(u) = exp(β(√(1 − (2u/w)²) − 1)) of width w grid points, take a d-D FFT,
+//! and divide each mode by the kernel's Fourier transform ψ̂(k/n) (type 2
+//! runs the same steps backwards). With w = ⌈log10(1/ε)⌉ + 1 and β = 2.30·w
+//! the relative error is about ε (BMK 2019, §3 and Eq. (3.2)): |ΔF(k)| ≲
+//! ε·Σ_j |c_j|.
+//!
+//! A plan is a value (STYLE.md §4): designed once for (d, h, ε), `Send +
+//! Sync`, reused across realizations with caller-supplied scratch.
+
+use std::sync::Arc;
+
+use rustfft::num_complex::Complex64;
+use rustfft::{Fft, FftDirection, FftPlanner};
+
+use super::{FrequencyBox, SpectrumError};
+use crate::points::PointSet;
+
+/// The sign of the exponent: e^(−2πi k·x) (`Negative`, the sample spectrum's)
+/// or e^(+2πi k·x).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sign {
+    /// e^(−2πi k·x).
+    Negative,
+    /// e^(+2πi k·x).
+    Positive,
+}
+
+/// A designed transform for one frequency box and tolerance.
+pub struct NufftPlan {
+    freqs: FrequencyBox,
+    tolerance: f64,
+    /// Fine grid points per axis.
+    grid: usize,
+    /// Kernel width in grid points.
+    width: usize,
+    beta: f64,
+    /// 1/ψ̂(k/n) for k = −h..=h.
+    correction: Vec<f64>,
+    forward: Arc<dyn Fft<f64>>,
+    inverse: Arc<dyn Fft<f64>>,
+}
+
+/// Working memory for one transform at a time (one per thread).
+pub struct NufftScratch {
+    grid: Vec<Complex64>,
+    swap: Vec<Complex64>,
+    fft: Vec<Complex64>,
+}
+
+impl NufftPlan {
+    /// Designs the transform on the box `freqs` with relative tolerance
+    /// `tolerance`.
+    ///
+    /// # Errors
+    /// [`SpectrumError::Tolerance`] outside [1e-14, 0.1];
+    /// [`SpectrumError::UnsupportedDimension`] outside d = 1..=4.
+    pub fn new(freqs: FrequencyBox, tolerance: f64) -> Result<Self, SpectrumError> {
+        if !(1..=4).contains(&freqs.dim) {
+            return Err(SpectrumError::UnsupportedDimension(freqs.dim));
+        }
+        if !(1e-14..=0.1).contains(&tolerance) {
+            return Err(SpectrumError::Tolerance(tolerance));
+        }
+        let width = ((1.0 / tolerance).log10().ceil() as usize + 1).clamp(2, 16);
+        let beta = 2.30 * width as f64;
+        let grid = fine_grid_size(2 * freqs.side()).max(2 * width);
+        let h = freqs.half as i64;
+        let correction = (-h..=h)
+            .map(|k| 1.0 / kernel_transform(k as f64 / grid as f64, width, beta))
+            .collect();
+        let mut planner = FftPlanner::new();
+        let forward = planner.plan_fft(grid, FftDirection::Forward);
+        let inverse = planner.plan_fft(grid, FftDirection::Inverse);
+        Ok(NufftPlan {
+            freqs,
+            tolerance,
+            grid,
+            width,
+            beta,
+            correction,
+            forward,
+            inverse,
+        })
+    }
+
+    /// The frequency box.
+    pub fn frequencies(&self) -> &FrequencyBox {
+        &self.freqs
+    }
+
+    /// The requested tolerance ε.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    /// Fine-grid points per axis.
+    pub fn grid_size(&self) -> usize {
+        self.grid
+    }
+
+    /// Kernel width in grid points.
+    pub fn kernel_width(&self) -> usize {
+        self.width
+    }
+
+    /// Complex numbers of scratch one transform needs.
+    pub fn scratch_len(&self) -> usize {
+        let cells = self.grid.pow(self.freqs.dim as u32);
+        2 * cells
+            + self
+                .forward
+                .get_inplace_scratch_len()
+                .max(self.inverse.get_inplace_scratch_len())
+    }
+
+    /// Fresh scratch for this plan.
+    pub fn make_scratch(&self) -> NufftScratch {
+        let cells = self.grid.pow(self.freqs.dim as u32);
+        let zero = Complex64::new(0.0, 0.0);
+        let fft_len = self
+            .forward
+            .get_inplace_scratch_len()
+            .max(self.inverse.get_inplace_scratch_len());
+        NufftScratch {
+            grid: vec![zero; cells],
+            swap: vec![zero; cells],
+            fft: vec![zero; fft_len],
+        }
+    }
+
+    /// Type 1: `out[k] = Σ_j c_j e^(±2πi k·x_j)` for every k of the box (box
+    /// order), with strengths c_j = `strengths[j]`, or 1 when `None`.
+    ///
+    /// # Panics
+    /// If dimensions or lengths disagree.
+    pub fn type1(
+        &self,
+        points: &PointSet,
+        strengths: Option<&[Complex64]>,
+        sign: Sign,
+        out: &mut [Complex64],
+        scratch: &mut NufftScratch,
+    ) {
+        self.check(points, out.len());
+        let one = Complex64::new(1.0, 0.0);
+        scratch.grid.fill(Complex64::new(0.0, 0.0));
+        let grid = &mut scratch.grid;
+        for (j, x) in points.points().enumerate() {
+            let c = strengths.map_or(one, |s| s[j]);
+            self.for_each_grid_neighbour(x, |cell, weight| grid[cell] += c * weight);
+        }
+        self.fft(scratch, sign);
+        let n = self.grid as i64;
+        let d = self.freqs.dim;
+        let mut k = vec![0i64; d];
+        for (idx, o) in out.iter_mut().enumerate() {
+            self.freqs.frequency(idx, &mut k);
+            let (cell, corr) = self.mode_cell(&k, n);
+            *o = scratch.grid[cell] * corr;
+        }
+    }
+
+    /// Type 2: `out[j] = Σ_k coeffs[k] e^(±2πi k·x_j)` for every point.
+    ///
+    /// # Panics
+    /// If dimensions or lengths disagree.
+    pub fn type2(
+        &self,
+        points: &PointSet,
+        coeffs: &[Complex64],
+        sign: Sign,
+        out: &mut [Complex64],
+        scratch: &mut NufftScratch,
+    ) {
+        self.check(points, coeffs.len());
+        assert_eq!(out.len(), points.len(), "one output per point");
+        scratch.grid.fill(Complex64::new(0.0, 0.0));
+        let n = self.grid as i64;
+        let mut k = vec![0i64; self.freqs.dim];
+        for (idx, &c) in coeffs.iter().enumerate() {
+            self.freqs.frequency(idx, &mut k);
+            let (cell, corr) = self.mode_cell(&k, n);
+            scratch.grid[cell] = c * corr;
+        }
+        self.fft(scratch, sign);
+        let grid = &scratch.grid;
+        for (o, x) in out.iter_mut().zip(points.points()) {
+            let mut acc = Complex64::new(0.0, 0.0);
+            self.for_each_grid_neighbour(x, |cell, weight| acc += grid[cell] * weight);
+            *o = acc;
+        }
+    }
+
+    fn check(&self, points: &PointSet, modes: usize) {
+        assert_eq!(
+            points.dim(),
+            self.freqs.dim,
+            "points and plan differ in dimension"
+        );
+        assert_eq!(modes, self.freqs.len(), "one value per mode of the box");
+    }
+
+    /// The fine-grid cell of mode k and its deconvolution factor Π 1/ψ̂.
+    #[inline]
+    fn mode_cell(&self, k: &[i64], n: i64) -> (usize, f64) {
+        let h = self.freqs.half as i64;
+        k.iter().rev().fold((0usize, 1.0), |(cell, corr), &kj| {
+            (
+                cell * self.grid + kj.rem_euclid(n) as usize,
+                corr * self.correction[(kj + h) as usize],
+            )
+        })
+    }
+
+    /// Calls `f(cell, ψ-weight)` for the w^d fine-grid cells around x.
+    fn for_each_grid_neighbour(&self, x: &[f64], mut f: impl FnMut(usize, f64)) {
+        let (w, n, d) = (self.width, self.grid, self.freqs.dim);
+        let mut weights = [[0.0f64; 16]; 4];
+        let mut cells = [[0usize; 16]; 4];
+        for (dim, &xj) in x.iter().enumerate() {
+            let t = xj * n as f64;
+            let first = (t - 0.5 * w as f64).ceil();
+            for a in 0..w {
+                let l = first + a as f64;
+                let z = 2.0 * (l - t) / w as f64;
+                weights[dim][a] = kernel(z, self.beta);
+                cells[dim][a] = (l as i64).rem_euclid(n as i64) as usize;
+            }
+        }
+        // Odometer over dimensions 1..d; dimension 0 runs contiguously inside.
+        let mut a = [0usize; 4];
+        loop {
+            let (mut base, mut weight) = (0usize, 1.0);
+            for dim in (1..d).rev() {
+                base = base * n + cells[dim][a[dim]];
+                weight *= weights[dim][a[dim]];
+            }
+            base *= n;
+            for a0 in 0..w {
+                f(base + cells[0][a0], weight * weights[0][a0]);
+            }
+            let mut dim = 1;
+            while dim < d {
+                a[dim] += 1;
+                if a[dim] < w {
+                    break;
+                }
+                a[dim] = 0;
+                dim += 1;
+            }
+            if dim >= d {
+                return;
+            }
+        }
+    }
+
+    /// In-place d-D FFT of the fine grid: FFT the contiguous axis, then
+    /// transpose the (n^(d−1) × n) matrix so the next axis is contiguous; d
+    /// rounds restore the layout.
+    fn fft(&self, scratch: &mut NufftScratch, sign: Sign) {
+        let fft = match sign {
+            Sign::Negative => &self.forward,
+            Sign::Positive => &self.inverse,
+        };
+        let n = self.grid;
+        let rows = scratch.grid.len() / n;
+        for _ in 0..self.freqs.dim {
+            fft.process_with_scratch(&mut scratch.grid, &mut scratch.fft);
+            if rows > 1 {
+                transpose(&scratch.grid, &mut scratch.swap, rows, n);
+                std::mem::swap(&mut scratch.grid, &mut scratch.swap);
+            }
+        }
+    }
+}
+
+/// Out-of-place transpose of a `rows × cols` row-major matrix, in tiles.
+fn transpose(src: &[Complex64], dst: &mut [Complex64], rows: usize, cols: usize) {
+    const TILE: usize = 32;
+    for r0 in (0..rows).step_by(TILE) {
+        for c0 in (0..cols).step_by(TILE) {
+            for r in r0..(r0 + TILE).min(rows) {
+                for c in c0..(c0 + TILE).min(cols) {
+                    dst[c * rows + r] = src[r * cols + c];
+                }
+            }
+        }
+    }
+}
+
+/// The ES kernel φ(z) = exp(β(√(1 − z²) − 1)) on [−1, 1], 0 outside
+/// (BMK 2019, Eq. (1.8)).
+#[inline]
+fn kernel(z: f64, beta: f64) -> f64 {
+    if z.abs() >= 1.0 {
+        0.0
+    } else {
+        (beta * ((1.0 - z * z).sqrt() - 1.0)).exp()
+    }
+}
+
+/// ψ̂(ξ) = ∫ ψ(u) e^(−2πiξu) du = (w/2) ∫_(−1)^(1) φ(z) cos(π w ξ z) dz, by
+/// Gauss–Legendre quadrature with enough nodes for double precision.
+fn kernel_transform(xi: f64, width: usize, beta: f64) -> f64 {
+    let (nodes, weights) = gauss_legendre(4 * width + 40);
+    let w = width as f64;
+    let sum: f64 = nodes
+        .iter()
+        .zip(&weights)
+        .map(|(&z, &q)| q * kernel(z, beta) * (std::f64::consts::PI * w * xi * z).cos())
+        .sum();
+    0.5 * w * sum
+}
+
+/// Nodes and weights of q-point Gauss–Legendre quadrature on [−1, 1]: roots
+/// of P_q by Newton's method from z ≈ cos(π(i − ¼)/(q + ½)), weights
+/// 2/((1 − z²) P_q'(z)²) (Abramowitz & Stegun 25.4.29).
+fn gauss_legendre(q: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut nodes = Vec::with_capacity(q);
+    let mut weights = Vec::with_capacity(q);
+    for i in 1..=q {
+        let mut z = (std::f64::consts::PI * (i as f64 - 0.25) / (q as f64 + 0.5)).cos();
+        let mut derivative = 0.0;
+        for _ in 0..100 {
+            // P_q(z) by the three-term recurrence; P_q' from P_q and P_(q−1).
+            let (mut p0, mut p1) = (1.0, z);
+            for m in 2..=q {
+                let p2 = ((2 * m - 1) as f64 * z * p1 - (m - 1) as f64 * p0) / m as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            derivative = q as f64 * (z * p1 - p0) / (z * z - 1.0);
+            let step = p1 / derivative;
+            z -= step;
+            if step.abs() < 1e-16 {
+                break;
+            }
+        }
+        nodes.push(z);
+        weights.push(2.0 / ((1.0 - z * z) * derivative * derivative));
+    }
+    (nodes, weights)
+}
+
+/// The smallest 2^a·3^b·5^c ≥ `min` (sizes RustFFT handles fastest).
+fn fine_grid_size(min: usize) -> usize {
+    (min..)
+        .find(|&n| {
+            let mut m = n;
+            for p in [2, 3, 5] {
+                while m % p == 0 {
+                    m /= p;
+                }
+            }
+            m == 1 && n % 2 == 0
+        })
+        .expect("a smooth number exists")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadrature_integrates_polynomials_exactly() {
+        let (z, w) = gauss_legendre(10);
+        let integral: f64 = z.iter().zip(&w).map(|(z, w)| w * z.powi(18)).sum();
+        assert!((integral - 2.0 / 19.0).abs() < 1e-14);
+        assert!((w.iter().sum::<f64>() - 2.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn grid_sizes_are_even_and_smooth() {
+        assert_eq!(fine_grid_size(510), 512);
+        assert_eq!(fine_grid_size(7), 8);
+        assert_eq!(fine_grid_size(250), 250);
+    }
+
+    #[test]
+    fn bad_tolerances_are_refused() {
+        let b = FrequencyBox { dim: 2, half: 4 };
+        assert!(NufftPlan::new(b, 0.0).is_err());
+        assert!(NufftPlan::new(b, 1e-16).is_err());
+        assert!(NufftPlan::new(b, f64::NAN).is_err());
+        assert!(NufftPlan::new(b, 1e-6).is_ok());
+    }
+}
