@@ -68,8 +68,8 @@ fn bad_pcf_parameters_are_errors() {
         .unwrap()
         .sample(&mut set_rng(0, 0))
         .unwrap();
-    assert!(pair_correlation(&[set.clone()], 0.45, 10, 0.02).is_err());
-    assert!(pair_correlation(&[set.clone()], 0.1, 10, 0.0).is_err());
-    assert!(pair_correlation(&[set], 0.1, 0, 0.01).is_err());
+    assert!(pair_correlation(std::slice::from_ref(&set), 0.45, 10, 0.02).is_err());
+    assert!(pair_correlation(std::slice::from_ref(&set), 0.1, 10, 0.0).is_err());
+    assert!(pair_correlation(std::slice::from_ref(&set), 0.1, 0, 0.01).is_err());
     assert!(pair_correlation(&[], 0.1, 10, 0.01).is_err());
 }
