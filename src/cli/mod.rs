@@ -3,9 +3,12 @@
 
 mod args;
 mod compare;
+mod pcf;
 mod plot;
 mod progress;
 mod sample;
+mod source;
+mod spectrum;
 
 use std::process::ExitCode;
 
@@ -26,6 +29,11 @@ enum Command {
     /// Draw pictures (PNG) of point sets.
     #[command(subcommand)]
     Plot(plot::PlotCommand),
+    /// Expected power spectrum of point sets (or a 2D projection): CSV,
+    /// radial profile with anisotropy, PNG pictures.
+    Spectrum(spectrum::Args),
+    /// Pair correlation function g(r) of point sets (Gaussian kernel estimator).
+    Pcf(pcf::Args),
     /// Generate every 2D sampler at one N and compare them side by side
     /// (the default job: try `varspec compare`).
     Compare(compare::Args),
@@ -38,6 +46,8 @@ pub fn main() -> ExitCode {
         Command::Sample(a) => sample::run(a),
         Command::Plot(c) => plot::run(c),
         Command::Compare(a) => compare::run(a),
+        Command::Spectrum(a) => spectrum::run(a),
+        Command::Pcf(a) => pcf::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

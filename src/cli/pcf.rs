@@ -1,0 +1,89 @@
+//! `varspec pcf`: the pair correlation function.
+
+use std::path::PathBuf;
+
+use super::progress;
+use super::source::SourceArgs;
+use varspec::io::write_atomic;
+use varspec::report::plot::{LinePlot, Series, line_plot_png};
+use varspec::samplers::packing_radius;
+use varspec::spectrum::pcf::pair_correlation;
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    source: SourceArgs,
+    /// Largest radius, in units of the densest-packing distance r_max.
+    #[arg(long, default_value_t = 2.5)]
+    range: f64,
+    /// Radii evaluated in (0, range].
+    #[arg(long, default_value_t = 100)]
+    bins: usize,
+    /// Gaussian kernel standard deviation σ, in units of r_max.
+    #[arg(long, default_value_t = 0.15)]
+    bandwidth: f64,
+    /// CSV output: r,r_rel,g (r_rel = r / r_max). Default: standard output.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// PNG plot of g against r / r_max.
+    #[arg(long)]
+    png: Option<PathBuf>,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let source = a.source.resolve()?;
+    let bar = progress::bar(source.count() as u64, "pcf");
+    let sets = (0..source.count())
+        .map(|r| {
+            bar.inc(1);
+            source.get(r)
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    bar.finish_and_clear();
+    let (n, d) = (sets[0].len(), sets[0].dim());
+    let unit = if d == 1 {
+        1.0 / n as f64
+    } else {
+        packing_radius(n, d.min(4))
+    };
+    let pcf = pair_correlation(&sets, a.range * unit, a.bins, a.bandwidth * unit)?;
+    let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
+        writeln!(w, "r,r_rel,g")?;
+        for (r, g) in pcf.r.iter().zip(&pcf.g) {
+            writeln!(w, "{r:?},{:?},{g:?}", r / unit)?;
+        }
+        Ok(())
+    };
+    match &a.csv {
+        Some(path) => write_atomic(path, write)?,
+        None if a.png.is_none() => write(&mut std::io::stdout().lock())?,
+        None => {}
+    }
+    if let Some(path) = &a.png {
+        let plot = LinePlot {
+            title: format!("pair correlation: {} ({} sets)", source.name(), sets.len()),
+            x_label: "r / r_max".into(),
+            y_label: "g(r)".into(),
+            log_log: false,
+            series: vec![
+                Series {
+                    label: "g".into(),
+                    points: pcf
+                        .r
+                        .iter()
+                        .map(|r| r / unit)
+                        .zip(pcf.g.iter().copied())
+                        .collect(),
+                    reference: false,
+                },
+                Series {
+                    label: "white noise".into(),
+                    points: vec![(0.0, 1.0), (a.range, 1.0)],
+                    reference: true,
+                },
+            ],
+        };
+        line_plot_png(&plot, path)?;
+    }
+    Ok(())
+}

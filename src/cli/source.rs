@@ -1,0 +1,130 @@
+//! Where analysed point sets come from: a point-set file, or fresh
+//! realizations of a sampler; optionally projected onto chosen dimensions.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+
+use super::args;
+use varspec::PointSet;
+use varspec::io::read_point_sets;
+use varspec::rng::set_rng;
+use varspec::samplers::{self, Sampler};
+
+#[derive(clap::Args)]
+pub struct SourceArgs {
+    /// Point-set file (CSV or UTK text); every set in it is used.
+    #[arg(conflicts_with = "sampler", required_unless_present = "sampler")]
+    points: Option<PathBuf>,
+    /// Instead of a file: draw fresh realizations of this sampler.
+    #[arg(long, requires = "n")]
+    sampler: Option<String>,
+    /// Points per realization (with --sampler).
+    #[arg(short = 'n', long = "points")]
+    n: Option<usize>,
+    /// Sampler dimension (with --sampler; default: the sampler's own).
+    #[arg(short = 'd', long = "dim")]
+    dim: Option<usize>,
+    /// Realizations to draw (with --sampler).
+    #[arg(long, default_value_t = 1)]
+    sets: usize,
+    /// Seed (with --sampler).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Sampler parameter key=value (with --sampler; repeatable).
+    #[arg(long = "param", value_parser = args::key_value)]
+    params: Vec<(String, String)>,
+    /// Analyse the projection onto these two dimensions, e.g. 0,2 (XU) or 1,3 (YV).
+    #[arg(long)]
+    dims: Option<String>,
+}
+
+/// Resolved point sets, realization by realization.
+pub enum Source {
+    /// Sets read from a file.
+    File {
+        sets: Vec<PointSet>,
+        dims: Option<Vec<usize>>,
+        name: String,
+    },
+    /// A sampler and its seed.
+    Sampler {
+        sampler: Box<dyn Sampler>,
+        seed: u64,
+        sets: usize,
+        dims: Option<Vec<usize>>,
+        name: String,
+    },
+}
+
+impl SourceArgs {
+    /// Reads the file or builds the sampler; checks the projection.
+    pub fn resolve(&self) -> anyhow::Result<Source> {
+        let dims = self.dims.as_deref().map(|d| args::dims(d, 2)).transpose()?;
+        let source = match (&self.points, &self.sampler) {
+            (Some(path), _) => Source::File {
+                sets: read_point_sets(path)?,
+                dims: dims.clone(),
+                name: path.display().to_string(),
+            },
+            (None, Some(name)) => {
+                if self.sets == 0 {
+                    bail!("--sets must be at least 1");
+                }
+                let n = self.n.context("--sampler needs -n")?;
+                let sampler = samplers::build(name, n, self.dim, &self.params)?;
+                Source::Sampler {
+                    sampler,
+                    seed: self.seed,
+                    sets: self.sets,
+                    dims: dims.clone(),
+                    name: format!("{name} N={n}"),
+                }
+            }
+            (None, None) => bail!("give a point-set file or --sampler"),
+        };
+        let first = source.get(0)?;
+        if first.dim() != 2 && dims.is_none() {
+            bail!(
+                "{}: points are {}-dimensional; choose a 2D projection with --dims (0,2 is XU, 1,3 is YV)",
+                source.name(),
+                first.dim()
+            );
+        }
+        Ok(source)
+    }
+}
+
+impl Source {
+    /// Number of realizations.
+    pub fn count(&self) -> usize {
+        match self {
+            Source::File { sets, .. } => sets.len(),
+            Source::Sampler { sets, .. } => *sets,
+        }
+    }
+
+    /// A label for titles and messages.
+    pub fn name(&self) -> &str {
+        match self {
+            Source::File { name, .. } | Source::Sampler { name, .. } => name,
+        }
+    }
+
+    /// Realization r, projected.
+    pub fn get(&self, r: usize) -> anyhow::Result<PointSet> {
+        let (set, dims) = match self {
+            Source::File { sets, dims, .. } => (sets[r].clone(), dims),
+            Source::Sampler {
+                sampler,
+                seed,
+                dims,
+                ..
+            } => (sampler.sample(&mut set_rng(*seed, r as u64))?, dims),
+        };
+        match dims {
+            Some(d) => set.projected(d).with_context(|| self.name().to_string()),
+            None => Ok(set),
+        }
+    }
+}

@@ -1,0 +1,305 @@
+//! Plots as PNG: spectra as log-scale heat maps with a colour bar, profiles
+//! and curves as line plots (plotters on an RGB buffer, encoded with
+//! `image`; text in the vendored DejaVu Sans).
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::prelude::*;
+use plotters::style::colors::colormaps::ViridisRGB;
+use plotters::style::{FontStyle, register_font};
+
+use super::png::save_png;
+use crate::Error;
+use crate::spectrum::Spectrum;
+
+static FONT: Once = Once::new();
+
+/// Registers the vendored font under plotters' "sans-serif" family, once.
+fn ensure_font() {
+    FONT.call_once(|| {
+        register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            include_bytes!("../../assets/fonts/DejaVuSans.ttf"),
+        )
+        .unwrap_or_else(|_| panic!("the vendored DejaVu Sans is a valid TrueType font"));
+    });
+}
+
+fn draw_error(e: impl std::fmt::Display) -> std::io::Error {
+    std::io::Error::other(format!("drawing failed: {e}"))
+}
+
+/// One curve of a line plot.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend text.
+    pub label: String,
+    /// (x, y) points in order.
+    pub points: Vec<(f64, f64)>,
+    /// Dashed reference line rather than data.
+    pub reference: bool,
+}
+
+/// A line plot with labelled axes, optionally log-log.
+#[derive(Debug, Clone)]
+pub struct LinePlot {
+    /// Title over the plot.
+    pub title: String,
+    /// Horizontal axis label.
+    pub x_label: String,
+    /// Vertical axis label.
+    pub y_label: String,
+    /// Both axes logarithmic.
+    pub log_log: bool,
+    /// The curves.
+    pub series: Vec<Series>,
+}
+
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// Writes `plot` as a 800×560 PNG at `path`, atomically.
+///
+/// # Errors
+/// [`Error::Write`] naming `path` (also for drawing failures).
+pub fn line_plot_png(plot: &LinePlot, path: &Path) -> Result<(), Error> {
+    ensure_font();
+    let (w, h) = (800u32, 560u32);
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    let drawn = draw_lines(plot, &mut buf, (w, h));
+    drawn.map_err(|source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let img = image::RgbImage::from_raw(w, h, buf).expect("buffer matches size");
+    save_png(&img, path)
+}
+
+fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Result<()> {
+    let finite = |v: f64| v.is_finite() && (!plot.log_log || v > 0.0);
+    let pts: Vec<(f64, f64)> = plot
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .filter(|&(x, y)| finite(x) && finite(y))
+        .collect();
+    if pts.is_empty() {
+        return Err(std::io::Error::other("nothing to plot: no finite points"));
+    }
+    let (mut x0, mut x1) = min_max(pts.iter().map(|p| p.0));
+    let (mut y0, mut y1) = min_max(pts.iter().map(|p| p.1));
+    if plot.log_log {
+        (x0, x1, y0, y1) = (x0 / 1.2, x1 * 1.2, y0 / 2.0, y1 * 2.0);
+    } else {
+        let (px, py) = ((x1 - x0).max(1e-300) * 0.03, (y1 - y0).max(1e-300) * 0.05);
+        (x0, x1, y0, y1) = (x0 - px, x1 + px, (y0 - py).min(0.0), y1 + py);
+    }
+    let root = BitMapBackend::with_buffer(buf, size).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_error)?;
+    let mut builder = ChartBuilder::on(&root);
+    builder
+        .caption(&plot.title, ("sans-serif", 22))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(80);
+    macro_rules! finish {
+        ($chart:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .x_desc(plot.x_label.as_str())
+                .y_desc(plot.y_label.as_str())
+                .label_style(("sans-serif", 15))
+                .axis_desc_style(("sans-serif", 17))
+                .light_line_style(RGBColor(235, 235, 235))
+                .draw()
+                .map_err(draw_error)?;
+            for (i, s) in plot.series.iter().enumerate() {
+                let colour = if s.reference {
+                    RGBColor(120, 120, 120)
+                } else {
+                    PALETTE[i % PALETTE.len()]
+                };
+                let data: Vec<(f64, f64)> = s
+                    .points
+                    .iter()
+                    .copied()
+                    .filter(|&(x, y)| finite(x) && finite(y))
+                    .collect();
+                let style = ShapeStyle::from(&colour).stroke_width(if s.reference { 1 } else { 2 });
+                let anno = if s.reference {
+                    chart
+                        .draw_series(DashedLineSeries::new(data, 6, 4, style))
+                        .map_err(draw_error)?
+                } else {
+                    chart
+                        .draw_series(LineSeries::new(data, style))
+                        .map_err(draw_error)?
+                };
+                anno.label(s.label.as_str()).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(2))
+                });
+            }
+            chart
+                .configure_series_labels()
+                .label_font(("sans-serif", 15))
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(160, 160, 160))
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()
+                .map_err(draw_error)?;
+        }};
+    }
+    if plot.log_log {
+        finish!(
+            builder
+                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                .map_err(draw_error)?
+        );
+    } else {
+        finish!(
+            builder
+                .build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(draw_error)?
+        );
+    }
+    root.present().map_err(draw_error)
+}
+
+fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    })
+}
+
+/// Writes a 2D power spectrum as a heat map centred at DC, log10 power in
+/// the viridis colour map with a labelled colour bar (760×640 PNG).
+///
+/// The colour range spans the powers at k ≠ 0: from the largest down at
+/// most four decades; DC (power N) is drawn in the top colour.
+///
+/// # Errors
+/// [`Error::Write`] naming `path`; a spectrum that is not 2D is refused the
+/// same way.
+pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(), Error> {
+    let fail = |source| Error::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    if spectrum.freqs.dim != 2 {
+        return Err(fail(std::io::Error::other(
+            "a spectrum picture needs a 2D spectrum (use --dims)",
+        )));
+    }
+    ensure_font();
+    let zero = spectrum.freqs.zero_index();
+    let logs: Vec<f64> = spectrum
+        .power
+        .iter()
+        .enumerate()
+        .filter(|&(i, &p)| i != zero && p > 0.0)
+        .map(|(_, &p)| p.log10())
+        .collect();
+    let (lo, hi) = match min_max(logs.iter().copied()) {
+        (lo, hi) if hi > lo => (lo.max(hi - 4.0), hi),
+        (_, hi) if hi.is_finite() => (hi - 1.0, hi + 1.0),
+        _ => (-1.0, 1.0),
+    };
+    let (w, h) = (760u32, 640u32);
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    let areas = draw_spectrum_frame(spectrum, title, (lo, hi), &mut buf, (w, h)).map_err(fail)?;
+    let (heat, bar) = areas;
+    let side = spectrum.freqs.side();
+    let colour = |v: f64| ViridisRGB::get_color_normalized(v.clamp(lo, hi), lo, hi);
+    let mut put = |x: i32, y: i32, c: RGBColor| {
+        let o = ((y as u32 * w + x as u32) * 3) as usize;
+        buf[o..o + 3].copy_from_slice(&[c.0, c.1, c.2]);
+    };
+    let (hx, hy) = heat;
+    for py in hy.clone() {
+        let fy = (py - hy.start) as f64 / (hy.end - hy.start) as f64;
+        let row = side - 1 - ((fy * side as f64) as usize).min(side - 1);
+        for px in hx.clone() {
+            let fx = (px - hx.start) as f64 / (hx.end - hx.start) as f64;
+            let col = ((fx * side as f64) as usize).min(side - 1);
+            let idx = row * side + col;
+            let p = spectrum.power[idx];
+            let v = if idx == zero || p <= 0.0 {
+                if idx == zero { hi } else { lo }
+            } else {
+                p.log10()
+            };
+            put(px, py, colour(v));
+        }
+    }
+    let (bx, by) = bar;
+    for py in by.clone() {
+        let v = hi - (py - by.start) as f64 / (by.end - by.start - 1).max(1) as f64 * (hi - lo);
+        for px in bx.clone() {
+            put(px, py, colour(v));
+        }
+    }
+    let img = image::RgbImage::from_raw(w, h, buf).expect("buffer matches size");
+    save_png(&img, path)
+}
+
+type PixelRange = (std::ops::Range<i32>, std::ops::Range<i32>);
+
+/// Draws axes, labels and colour-bar ticks; returns the pixel ranges of the
+/// heat map and the colour bar, which the caller fills.
+fn draw_spectrum_frame(
+    spectrum: &Spectrum,
+    title: &str,
+    (lo, hi): (f64, f64),
+    buf: &mut [u8],
+    size: (u32, u32),
+) -> std::io::Result<(PixelRange, PixelRange)> {
+    let h = spectrum.freqs.half as f64;
+    let root = BitMapBackend::with_buffer(buf, size).into_drawing_area();
+    root.fill(&WHITE).map_err(draw_error)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(draw_error)?;
+    let (left, right) = root.split_horizontally(size.0 - 150);
+    let mut heat = ChartBuilder::on(&left)
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(56)
+        .build_cartesian_2d(-h - 0.5..h + 0.5, -h - 0.5..h + 0.5)
+        .map_err(draw_error)?;
+    heat.configure_mesh()
+        .disable_mesh()
+        .x_desc("kx")
+        .y_desc("ky")
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 17))
+        .draw()
+        .map_err(draw_error)?;
+    let mut bar = ChartBuilder::on(&right)
+        .margin_top(12)
+        .margin_bottom(56)
+        .margin_right(12)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(draw_error)?;
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_desc("log10 power (N·P_S)")
+        .label_style(("sans-serif", 15))
+        .axis_desc_style(("sans-serif", 15))
+        .draw()
+        .map_err(draw_error)?;
+    let ranges = (
+        heat.plotting_area().get_pixel_range(),
+        bar.plotting_area().get_pixel_range(),
+    );
+    root.present().map_err(draw_error)?;
+    Ok(ranges)
+}

@@ -1,0 +1,224 @@
+//! `varspec spectrum` and `varspec pcf` as scripts use them.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn varspec(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args(args)
+        .output()
+        .expect("the varspec binary runs")
+}
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("varspec-clispec-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn ok(out: &Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn xu_projection_equals_the_spectrum_of_the_xu_columns() {
+    let dir = temp_dir("xu");
+    let (four, two) = (dir.join("umj.csv"), dir.join("xu.csv"));
+    ok(&varspec(&[
+        "sample",
+        "umj",
+        "-n",
+        "64",
+        "--sets",
+        "4",
+        "-o",
+        s(&four),
+    ]));
+    // Build the 2D file of (x, u) columns by hand.
+    let text = std::fs::read_to_string(&four).unwrap();
+    let mut xu = String::from("set,x0,x1\n");
+    for line in text.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        xu += &format!("{},{},{}\n", f[0], f[1], f[3]);
+    }
+    std::fs::write(&two, xu).unwrap();
+    let (a, b) = (dir.join("a.csv"), dir.join("b.csv"));
+    ok(&varspec(&[
+        "spectrum",
+        s(&four),
+        "--dims",
+        "0,2",
+        "--res",
+        "32",
+        "--csv",
+        s(&a),
+    ]));
+    ok(&varspec(&[
+        "spectrum",
+        s(&two),
+        "--res",
+        "32",
+        "--csv",
+        s(&b),
+    ]));
+    let (a, b) = (
+        std::fs::read_to_string(&a).unwrap(),
+        std::fs::read_to_string(&b).unwrap(),
+    );
+    assert!(a.starts_with("kx,ky,power\n"));
+    assert_eq!(a.lines().count(), 1 + 31 * 31);
+    assert_eq!(a, b);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn outputs_are_written_in_every_format() {
+    let dir = temp_dir("out");
+    let (csv, radial, png, rpng) = (
+        dir.join("s.csv"),
+        dir.join("r.csv"),
+        dir.join("s.png"),
+        dir.join("r.png"),
+    );
+    let out = varspec(&[
+        "spectrum",
+        "--sampler",
+        "jitter",
+        "-n",
+        "256",
+        "--sets",
+        "20",
+        "--res",
+        "64",
+        "--csv",
+        s(&csv),
+        "--radial",
+        s(&radial),
+        "--png",
+        s(&png),
+        "--radial-png",
+        s(&rpng),
+    ]);
+    ok(&out);
+    let radial = std::fs::read_to_string(&radial).unwrap();
+    assert!(radial.starts_with("k,power,anisotropy\n"));
+    assert_eq!(radial.lines().count(), 1 + 31);
+    for p in [&png, &rpng] {
+        let img = image::open(p).unwrap();
+        assert!(img.width() > 500 && img.height() > 500);
+    }
+    let pcf_csv = dir.join("g.csv");
+    ok(&varspec(&[
+        "pcf",
+        "--sampler",
+        "poisson-disk",
+        "-n",
+        "512",
+        "--sets",
+        "4",
+        "--csv",
+        s(&pcf_csv),
+        "--png",
+        s(&png),
+    ]));
+    let g = std::fs::read_to_string(&pcf_csv).unwrap();
+    assert!(g.starts_with("r,r_rel,g\n") && g.lines().count() == 101);
+    // With no output option the radial profile goes to stdout.
+    let stdout = varspec(&["spectrum", "--sampler", "random", "-n", "64", "--res", "16"]);
+    assert!(
+        String::from_utf8(stdout.stdout)
+            .unwrap()
+            .starts_with("k,power,anisotropy\n")
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_spectrum_requests_are_clear_errors() {
+    let dir = temp_dir("bad");
+    let four = dir.join("umj.csv");
+    ok(&varspec(&["sample", "umj", "-n", "16", "-o", s(&four)]));
+    let broken = dir.join("broken.csv");
+    std::fs::write(&broken, "x0,x1\n0.1,0.2\n0.3,nan\n").unwrap();
+    for (args, phrase) in [
+        (vec!["spectrum", s(&four), "--dims", "0,4"], "out of range"),
+        (vec!["spectrum", s(&four), "--dims", "1,1"], "repeated"),
+        (
+            vec!["spectrum", s(&four), "--dims", "0"],
+            "expected 2 indices",
+        ),
+        (
+            vec!["spectrum", s(&four)],
+            "choose a 2D projection with --dims",
+        ),
+        (
+            vec!["spectrum", s(&four), "--dims", "0,2", "--tol", "0"],
+            "tolerance 0 is outside",
+        ),
+        (
+            vec!["spectrum", s(&four), "--dims", "0,2", "--tol", "-1e-6"],
+            "outside",
+        ),
+        (
+            vec!["spectrum", s(&four), "--dims", "0,2", "--res", "200000"],
+            "MiB",
+        ),
+        (
+            vec!["spectrum", s(&four), "--dims", "0,2", "--res", "1"],
+            "K >= 2",
+        ),
+        (vec!["spectrum", s(&broken)], "broken.csv:3:"),
+        (vec!["pcf", s(&broken)], "broken.csv:3:"),
+        (
+            vec!["pcf", s(&four), "--dims", "0,1", "--range", "40"],
+            "alias",
+        ),
+        (
+            vec!["spectrum", "--sampler", "jitter", "-n", "10"],
+            "nearest valid N: 9 or 16",
+        ),
+    ] {
+        let out = varspec(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(
+            err.contains(phrase),
+            "{args:?}: {err:?} should contain {phrase:?}"
+        );
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn spectrum_output_does_not_depend_on_thread_count() {
+    let run = |threads: &str| {
+        Command::new(env!("CARGO_BIN_EXE_varspec"))
+            .args([
+                "spectrum",
+                "--sampler",
+                "cmj",
+                "-n",
+                "100",
+                "--sets",
+                "50",
+                "--res",
+                "32",
+                "--seed",
+                "9",
+            ])
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap()
+            .stdout
+    };
+    assert_eq!(run("1"), run("2"));
+}
