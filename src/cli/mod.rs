@@ -2,6 +2,7 @@
 //! errors are printed once, here, and turn into a non-zero exit.
 
 mod args;
+mod bench;
 mod compare;
 mod pcf;
 mod plot;
@@ -34,6 +35,9 @@ enum Command {
     Spectrum(spectrum::Args),
     /// Pair correlation function g(r) of point sets (Gaussian kernel estimator).
     Pcf(pcf::Args),
+    /// Benchmarks that print speed against error.
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
     /// Generate every 2D sampler at one N and compare them side by side
     /// (the default job: try `varspec compare`).
     Compare(compare::Args),
@@ -48,6 +52,7 @@ pub fn main() -> ExitCode {
         Command::Compare(a) => compare::run(a),
         Command::Spectrum(a) => spectrum::run(a),
         Command::Pcf(a) => pcf::run(a),
+        Command::Bench(c) => bench::run(c),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

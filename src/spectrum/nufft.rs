@@ -20,6 +20,7 @@
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
 use rustfft::{Fft, FftDirection, FftPlanner};
 
@@ -47,6 +48,8 @@ pub struct NufftPlan {
     beta: f64,
     /// 1/ψ̂(k/n) for k = −h..=h.
     correction: Vec<f64>,
+    /// Fine-grid index k mod n for k = −h..=h.
+    mode_cells: Vec<usize>,
     forward: Arc<dyn Fft<f64>>,
     inverse: Arc<dyn Fft<f64>>,
 }
@@ -55,7 +58,6 @@ pub struct NufftPlan {
 pub struct NufftScratch {
     grid: Vec<Complex64>,
     swap: Vec<Complex64>,
-    fft: Vec<Complex64>,
 }
 
 impl NufftPlan {
@@ -79,6 +81,9 @@ impl NufftPlan {
         let correction = (-h..=h)
             .map(|k| 1.0 / kernel_transform(k as f64 / grid as f64, width, beta))
             .collect();
+        let mode_cells = (-h..=h)
+            .map(|k| k.rem_euclid(grid as i64) as usize)
+            .collect();
         let mut planner = FftPlanner::new();
         let forward = planner.plan_fft(grid, FftDirection::Forward);
         let inverse = planner.plan_fft(grid, FftDirection::Inverse);
@@ -89,6 +94,7 @@ impl NufftPlan {
             width,
             beta,
             correction,
+            mode_cells,
             forward,
             inverse,
         })
@@ -114,28 +120,18 @@ impl NufftPlan {
         self.width
     }
 
-    /// Complex numbers of scratch one transform needs.
+    /// Complex numbers of scratch one transform needs (two fine grids).
     pub fn scratch_len(&self) -> usize {
-        let cells = self.grid.pow(self.freqs.dim as u32);
-        2 * cells
-            + self
-                .forward
-                .get_inplace_scratch_len()
-                .max(self.inverse.get_inplace_scratch_len())
+        2 * self.grid.pow(self.freqs.dim as u32)
     }
 
     /// Fresh scratch for this plan.
     pub fn make_scratch(&self) -> NufftScratch {
         let cells = self.grid.pow(self.freqs.dim as u32);
         let zero = Complex64::new(0.0, 0.0);
-        let fft_len = self
-            .forward
-            .get_inplace_scratch_len()
-            .max(self.inverse.get_inplace_scratch_len());
         NufftScratch {
             grid: vec![zero; cells],
             swap: vec![zero; cells],
-            fft: vec![zero; fft_len],
         }
     }
 
@@ -160,15 +156,18 @@ impl NufftPlan {
             let c = strengths.map_or(one, |s| s[j]);
             self.for_each_grid_neighbour(x, |cell, weight| grid[cell] += c * weight);
         }
-        self.fft(scratch, sign);
-        let n = self.grid as i64;
-        let d = self.freqs.dim;
-        let mut k = vec![0i64; d];
-        for (idx, o) in out.iter_mut().enumerate() {
-            self.freqs.frequency(idx, &mut k);
-            let (cell, corr) = self.mode_cell(&k, n);
-            *o = scratch.grid[cell] * corr;
-        }
+        self.fft(scratch, sign, Prune::Type1);
+        let grid = &scratch.grid;
+        self.for_each_mode_row(|row, base, corr| {
+            let out_row = &mut out[row * self.freqs.side()..(row + 1) * self.freqs.side()];
+            for ((o, &cell), &c) in out_row
+                .iter_mut()
+                .zip(&self.mode_cells)
+                .zip(&self.correction)
+            {
+                *o = grid[base + cell] * (corr * c);
+            }
+        });
     }
 
     /// Type 2: `out[j] = Σ_k coeffs[k] e^(±2πi k·x_j)` for every point.
@@ -186,14 +185,14 @@ impl NufftPlan {
         self.check(points, coeffs.len());
         assert_eq!(out.len(), points.len(), "one output per point");
         scratch.grid.fill(Complex64::new(0.0, 0.0));
-        let n = self.grid as i64;
-        let mut k = vec![0i64; self.freqs.dim];
-        for (idx, &c) in coeffs.iter().enumerate() {
-            self.freqs.frequency(idx, &mut k);
-            let (cell, corr) = self.mode_cell(&k, n);
-            scratch.grid[cell] = c * corr;
-        }
-        self.fft(scratch, sign);
+        let grid = &mut scratch.grid;
+        self.for_each_mode_row(|row, base, corr| {
+            let in_row = &coeffs[row * self.freqs.side()..(row + 1) * self.freqs.side()];
+            for ((c, &cell), &k) in in_row.iter().zip(&self.mode_cells).zip(&self.correction) {
+                grid[base + cell] = c * (corr * k);
+            }
+        });
+        self.fft(scratch, sign, Prune::Type2);
         let grid = &scratch.grid;
         for (o, x) in out.iter_mut().zip(points.points()) {
             let mut acc = Complex64::new(0.0, 0.0);
@@ -211,16 +210,23 @@ impl NufftPlan {
         assert_eq!(modes, self.freqs.len(), "one value per mode of the box");
     }
 
-    /// The fine-grid cell of mode k and its deconvolution factor Π 1/ψ̂.
-    #[inline]
-    fn mode_cell(&self, k: &[i64], n: i64) -> (usize, f64) {
-        let h = self.freqs.half as i64;
-        k.iter().rev().fold((0usize, 1.0), |(cell, corr), &kj| {
-            (
-                cell * self.grid + kj.rem_euclid(n) as usize,
-                corr * self.correction[(kj + h) as usize],
-            )
-        })
+    /// Calls `f(row, base, corr)` for each row of the mode box (modes with
+    /// fixed k_1..k_(d−1), k_0 running): `base` is the fine-grid offset of
+    /// those k_1.. and `corr` their deconvolution factor Π 1/ψ̂; the row's
+    /// k_0 = −h..h then sit at `base + mode_cells[k_0 + h]`.
+    fn for_each_mode_row(&self, mut f: impl FnMut(usize, usize, f64)) {
+        let (side, d, n) = (self.freqs.side(), self.freqs.dim, self.grid);
+        for row in 0..side.pow(d as u32 - 1) {
+            let (mut rest, mut base, mut corr, mut scale) = (row, 0, 1.0, n);
+            for _ in 1..d {
+                let i = rest % side;
+                rest /= side;
+                base += self.mode_cells[i] * scale;
+                corr *= self.correction[i];
+                scale *= n;
+            }
+            f(row, base, corr);
+        }
     }
 
     /// Calls `f(cell, ψ-weight)` for the w^d fine-grid cells around x.
@@ -265,38 +271,125 @@ impl NufftPlan {
         }
     }
 
-    /// In-place d-D FFT of the fine grid: FFT the contiguous axis, then
-    /// transpose the (n^(d−1) × n) matrix so the next axis is contiguous; d
-    /// rounds restore the layout.
-    fn fft(&self, scratch: &mut NufftScratch, sign: Sign) {
+    /// In-place d-D FFT of the fine grid, axis by axis, pruned to the lines
+    /// that matter: a type-1 transform keeps only modes |k| ≤ h, so after an
+    /// axis is transformed only its kept indices are carried on; a type-2
+    /// grid is zero outside the kept modes, so lines through untransformed
+    /// zero indices are skipped. Lines are transformed in parallel; each line
+    /// is one FFT, so the result does not depend on the thread count.
+    fn fft(&self, scratch: &mut NufftScratch, sign: Sign, prune: Prune) {
         let fft = match sign {
             Sign::Negative => &self.forward,
             Sign::Positive => &self.inverse,
         };
-        let n = self.grid;
-        let rows = scratch.grid.len() / n;
-        for _ in 0..self.freqs.dim {
-            fft.process_with_scratch(&mut scratch.grid, &mut scratch.fft);
-            if rows > 1 {
-                transpose(&scratch.grid, &mut scratch.swap, rows, n);
-                std::mem::swap(&mut scratch.grid, &mut scratch.swap);
-            }
+        for axis in 0..self.freqs.dim {
+            self.fft_axis(scratch, axis, prune, fft);
         }
+    }
+
+    /// Whether grid index `i` of an axis holds a kept mode (k mod n, |k| ≤ h).
+    #[inline]
+    fn kept(&self, i: usize) -> bool {
+        i <= self.freqs.half || i >= self.grid - self.freqs.half
+    }
+
+    /// Indices (little-endian over `axes` axes of size n) whose every digit
+    /// is kept, or all of them.
+    fn positions(&self, axes: usize, restricted: bool) -> Vec<usize> {
+        let n = self.grid;
+        (0..n.pow(axes as u32))
+            .filter(|&p| {
+                !restricted || {
+                    let mut rest = p;
+                    (0..axes).all(|_| {
+                        let ok = self.kept(rest % n);
+                        rest /= n;
+                        ok
+                    })
+                }
+            })
+            .collect()
+    }
+
+    fn fft_axis(
+        &self,
+        scratch: &mut NufftScratch,
+        axis: usize,
+        prune: Prune,
+        fft: &Arc<dyn Fft<f64>>,
+    ) {
+        const LINES_PER_TASK: usize = 16;
+        let (n, d) = (self.grid, self.freqs.dim);
+        let inner = self.positions(axis, prune == Prune::Type1);
+        let outer = self.positions(d - 1 - axis, prune == Prune::Type2);
+        let fft_scratch = fft.get_inplace_scratch_len();
+        let zero = Complex64::new(0.0, 0.0);
+        if axis == 0 {
+            // Lines are contiguous rows: transform the needed ones in place.
+            let mut wanted = vec![false; scratch.grid.len() / n];
+            for &o in &outer {
+                wanted[o] = true;
+            }
+            scratch
+                .grid
+                .par_chunks_mut(n * LINES_PER_TASK)
+                .enumerate()
+                .for_each_init(
+                    || vec![zero; fft_scratch],
+                    |buf, (task, rows)| {
+                        for (r, row) in rows.chunks_exact_mut(n).enumerate() {
+                            if wanted[task * LINES_PER_TASK + r] {
+                                fft.process_with_scratch(row, buf);
+                            }
+                        }
+                    },
+                );
+            return;
+        }
+        // Line (o, q) runs through o·n^(axis+1) + t·n^axis + q, t = 0..n:
+        // gather the lines contiguously, transform them, scatter them back.
+        let stride = n.pow(axis as u32);
+        let lines = outer.len() * inner.len();
+        let grid = &scratch.grid;
+        let buf = &mut scratch.swap[..lines * n];
+        buf.par_chunks_mut(n).enumerate().for_each(|(l, line)| {
+            let base = outer[l / inner.len()] * stride * n + inner[l % inner.len()];
+            for (t, v) in line.iter_mut().enumerate() {
+                *v = grid[base + t * stride];
+            }
+        });
+        buf.par_chunks_mut(n * LINES_PER_TASK).for_each_init(
+            || vec![zero; fft_scratch],
+            |s, chunk| fft.process_with_scratch(chunk, s),
+        );
+        let buf = &scratch.swap[..lines * n];
+        let mut outer_index = vec![None; n.pow((d - 1 - axis) as u32)];
+        for (i, &o) in outer.iter().enumerate() {
+            outer_index[o] = Some(i);
+        }
+        // Each chunk of n^axis elements is one (o, t) row: disjoint writes.
+        scratch
+            .grid
+            .par_chunks_mut(stride)
+            .enumerate()
+            .for_each(|(c, row)| {
+                if let Some(oi) = outer_index[c / n] {
+                    let t = c % n;
+                    for (qi, &q) in inner.iter().enumerate() {
+                        row[q] = buf[(oi * inner.len() + qi) * n + t];
+                    }
+                }
+            });
     }
 }
 
-/// Out-of-place transpose of a `rows × cols` row-major matrix, in tiles.
-fn transpose(src: &[Complex64], dst: &mut [Complex64], rows: usize, cols: usize) {
-    const TILE: usize = 32;
-    for r0 in (0..rows).step_by(TILE) {
-        for c0 in (0..cols).step_by(TILE) {
-            for r in r0..(r0 + TILE).min(rows) {
-                for c in c0..(c0 + TILE).min(cols) {
-                    dst[c * rows + r] = src[r * cols + c];
-                }
-            }
-        }
-    }
+/// Which lines a pruned FFT may skip.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Prune {
+    /// Only kept output modes are read afterwards.
+    Type1,
+    /// Only kept input modes are nonzero.
+    Type2,
 }
 
 /// The ES kernel φ(z) = exp(β(√(1 − z²) − 1)) on [−1, 1], 0 outside
