@@ -9,6 +9,7 @@
 //! number of threads.
 
 pub mod error;
+pub mod integrands;
 pub mod io;
 pub mod neighbours;
 pub mod points;
@@ -16,6 +17,7 @@ pub mod report;
 pub mod rng;
 pub mod samplers;
 pub mod spectrum;
+pub mod variance;
 
 pub use error::Error;
 pub use points::PointSet;

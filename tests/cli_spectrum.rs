@@ -157,7 +157,7 @@ fn bad_spectrum_requests_are_clear_errors() {
         ),
         (
             vec!["spectrum", s(&four)],
-            "choose a 2D projection with --dims",
+            "choose a projection with --dims",
         ),
         (
             vec!["spectrum", s(&four), "--dims", "0,2", "--tol", "0"],

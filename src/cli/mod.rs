@@ -4,8 +4,10 @@
 mod args;
 mod bench;
 mod compare;
+mod integrands;
 mod pcf;
 mod plot;
+mod predict;
 mod progress;
 mod sample;
 mod source;
@@ -35,6 +37,11 @@ enum Command {
     Spectrum(spectrum::Args),
     /// Pair correlation function g(r) of point sets (Gaussian kernel estimator).
     Pcf(pcf::Args),
+    /// Variance of the shift-randomized estimator: Fourier, spatial and
+    /// empirical predictors side by side.
+    Predict(predict::Args),
+    /// The reference integrands and their parameters.
+    Integrands(integrands::Args),
     /// Benchmarks that print speed against error.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -53,6 +60,8 @@ pub fn main() -> ExitCode {
         Command::Spectrum(a) => spectrum::run(a),
         Command::Pcf(a) => pcf::run(a),
         Command::Bench(c) => bench::run(c),
+        Command::Predict(a) => predict::run(a),
+        Command::Integrands(a) => integrands::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

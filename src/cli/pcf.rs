@@ -31,7 +31,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let source = a.source.resolve()?;
+    let source = a.source.resolve(None)?;
     let bar = progress::bar(source.count() as u64, "pcf");
     let sets = (0..source.count())
         .map(|r| {

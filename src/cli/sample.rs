@@ -34,7 +34,7 @@ pub struct Args {
     #[arg(required_unless_present = "list")]
     sampler: Option<String>,
     /// Points per set.
-    #[arg(short = 'n', long = "points", required_unless_present = "list")]
+    #[arg(short = 'n', required_unless_present = "list")]
     n: Option<usize>,
     /// Dimension (default: the sampler's own, 2 for most, 4 for umj).
     #[arg(short = 'd', long = "dim")]

@@ -14,19 +14,22 @@ use varspec::samplers::{self, Sampler};
 #[derive(clap::Args)]
 pub struct SourceArgs {
     /// Point-set file (CSV or UTK text); every set in it is used.
-    #[arg(conflicts_with = "sampler", required_unless_present = "sampler")]
+    #[arg(conflicts_with_all = ["sampler", "points_flag"], required_unless_present_any = ["sampler", "points_flag"])]
     points: Option<PathBuf>,
+    /// The same as the positional point-set file.
+    #[arg(long = "points", conflicts_with = "sampler", value_name = "FILE")]
+    points_flag: Option<PathBuf>,
     /// Instead of a file: draw fresh realizations of this sampler.
     #[arg(long, requires = "n")]
     sampler: Option<String>,
     /// Points per realization (with --sampler).
-    #[arg(short = 'n', long = "points")]
+    #[arg(short = 'n')]
     n: Option<usize>,
     /// Sampler dimension (with --sampler; default: the sampler's own).
     #[arg(short = 'd', long = "dim")]
     dim: Option<usize>,
-    /// Realizations to draw (with --sampler).
-    #[arg(long, default_value_t = 1)]
+    /// Realizations to draw and average (with --sampler).
+    #[arg(long, default_value_t = 16)]
     sets: usize,
     /// Seed (with --sampler).
     #[arg(long, default_value_t = 0)]
@@ -34,7 +37,7 @@ pub struct SourceArgs {
     /// Sampler parameter key=value (with --sampler; repeatable).
     #[arg(long = "param", value_parser = args::key_value)]
     params: Vec<(String, String)>,
-    /// Analyse the projection onto these two dimensions, e.g. 0,2 (XU) or 1,3 (YV).
+    /// Analyse the projection onto these dimensions, e.g. 0,2 (XU) or 1,3 (YV).
     #[arg(long)]
     dims: Option<String>,
 }
@@ -58,10 +61,18 @@ pub enum Source {
 }
 
 impl SourceArgs {
-    /// Reads the file or builds the sampler; checks the projection.
-    pub fn resolve(&self) -> anyhow::Result<Source> {
-        let dims = self.dims.as_deref().map(|d| args::dims(d, 2)).transpose()?;
-        let source = match (&self.points, &self.sampler) {
+    /// Reads the file or builds the sampler; checks that the (projected)
+    /// points are `dim`-dimensional (any dimension for `None`).
+    pub fn resolve(&self, dim: Option<usize>) -> anyhow::Result<Source> {
+        let dims = self
+            .dims
+            .as_deref()
+            .map(|d| args::dims(d, dim.unwrap_or_else(|| d.split(',').count())))
+            .transpose()?;
+        let source = match (
+            self.points.as_ref().or(self.points_flag.as_ref()),
+            &self.sampler,
+        ) {
             (Some(path), _) => Source::File {
                 sets: read_point_sets(path)?,
                 dims: dims.clone(),
@@ -84,9 +95,10 @@ impl SourceArgs {
             (None, None) => bail!("give a point-set file or --sampler"),
         };
         let first = source.get(0)?;
-        if first.dim() != 2 && dims.is_none() {
+        if let Some(dim) = dim.filter(|&d| d != first.dim()) {
             bail!(
-                "{}: points are {}-dimensional; choose a 2D projection with --dims (0,2 is XU, 1,3 is YV)",
+                "{}: points are {}-dimensional where {dim} dimensions are needed; choose a projection with --dims \
+                 (0,2 is XU, 1,3 is YV)",
                 source.name(),
                 first.dim()
             );
@@ -108,6 +120,16 @@ impl Source {
     pub fn name(&self) -> &str {
         match self {
             Source::File { name, .. } | Source::Sampler { name, .. } => name,
+        }
+    }
+
+    /// Realization r for estimators that need more realizations than the
+    /// source holds: a file's sets are reused cyclically, a sampler draws
+    /// fresh ones.
+    pub fn get_cyclic(&self, r: usize) -> anyhow::Result<PointSet> {
+        match self {
+            Source::File { sets, .. } => self.get(r % sets.len()),
+            Source::Sampler { .. } => self.get(r),
         }
     }
 

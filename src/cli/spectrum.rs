@@ -58,7 +58,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let freqs = FrequencyBox::from_resolution(2, a.res);
     check_memory(&freqs, method, a.res)?;
-    let source = a.source.resolve()?;
+    let source = a.source.resolve(Some(2))?;
     let bar = progress::bar(source.count() as u64, "spectrum");
     let spectrum = expected_power(freqs, method, source.count(), |r| source.get(r), &|| {
         bar.inc(1)

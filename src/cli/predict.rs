@@ -1,0 +1,151 @@
+//! `varspec predict`: the variance of the shift-randomized estimator by the
+//! Fourier, spatial and empirical predictors, side by side.
+
+use std::time::Instant;
+
+use anyhow::anyhow;
+use clap::ValueEnum;
+use serde_json::{Value, json};
+
+use super::source::SourceArgs;
+use varspec::integrands;
+use varspec::variance::{VarianceError, empirical, fourier, spatial};
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum MethodArg {
+    Fourier,
+    Spatial,
+    Empirical,
+    All,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    source: SourceArgs,
+    /// Integrand spec, e.g. disk:r=0.3 (see `varspec integrands --list`).
+    #[arg(long)]
+    integrand: String,
+    /// Which predictor(s) to run.
+    #[arg(long, value_enum, default_value_t = MethodArg::All)]
+    method: MethodArg,
+    /// Realizations (fresh sampler randomness and shift each) of the empirical predictor.
+    #[arg(long, default_value_t = 10_000)]
+    realizations: usize,
+    /// Fourier box |k| < K/2 (default 256 in 2D, 16 in 4D).
+    #[arg(long)]
+    res: Option<usize>,
+    /// NUFFT tolerance of the Fourier predictor's spectrum.
+    #[arg(long, default_value_t = 1e-10)]
+    tol: f64,
+    /// Print one JSON object (the scripting interface).
+    #[arg(long)]
+    json: bool,
+}
+
+/// Wraps a library error so `?` works inside the realization closures.
+fn lift(e: anyhow::Error) -> VarianceError {
+    match e.downcast::<VarianceError>() {
+        Ok(v) => v,
+        Err(e) => match e.downcast::<varspec::samplers::SamplerError>() {
+            Ok(s) => VarianceError::Sampler(s),
+            Err(e) => {
+                VarianceError::Spectrum(varspec::spectrum::SpectrumError::Pcf(format!("{e:#}")))
+            }
+        },
+    }
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let f = integrands::parse(&a.integrand)?;
+    let source = a.source.resolve(Some(f.dim()))?;
+    let sets = source.count();
+    let n = source.get(0)?.len();
+    let wants = |m: MethodArg| a.method == m || a.method == MethodArg::All;
+    let mut out = serde_json::Map::new();
+    out.insert("integrand".into(), json!(f.spec()));
+    out.insert("source".into(), json!(source.name()));
+    out.insert("n".into(), json!(n));
+    out.insert("integral".into(), json!(f.integral()));
+    out.insert(
+        "estimator".into(),
+        json!("shift-randomized: uniform toroidal shift of every dimension"),
+    );
+    if wants(MethodArg::Fourier) {
+        let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
+        let half = res.saturating_sub(1) / 2;
+        let start = Instant::now();
+        let e = fourier(f.as_ref(), half, a.tol, sets, |r| {
+            source.get(r).map_err(lift)
+        })?;
+        out.insert(
+            "fourier".into(),
+            json!({
+                "variance": e.variance, "truncation_bound": e.truncation_bound, "in_box": e.in_box,
+                "tail": e.tail, "res": res, "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
+            }),
+        );
+    }
+    if wants(MethodArg::Spatial) {
+        let start = Instant::now();
+        let value = match spatial(f.as_ref(), sets, |r| source.get(r).map_err(lift)) {
+            Ok(e) => json!({
+                "variance": e.variance, "stderr": e.stderr, "rounding_bound": e.rounding_bound,
+                "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
+            }),
+            Err(e @ VarianceError::NoAutocovariance { .. }) => {
+                json!({"variance": Value::Null, "skipped": e.to_string()})
+            }
+            Err(e) => return Err(anyhow!(e)),
+        };
+        out.insert("spatial".into(), value);
+    }
+    if wants(MethodArg::Empirical) {
+        let start = Instant::now();
+        let seed = 0x454d_5049_5249_4341;
+        let e = empirical(f.as_ref(), a.realizations, seed, |r| {
+            source.get_cyclic(r).map_err(lift)
+        })?;
+        out.insert(
+            "empirical".into(),
+            json!({
+                "variance": e.variance, "ci_low": e.ci_low, "ci_high": e.ci_high, "mean": e.mean,
+                "realizations": e.realizations, "seconds": start.elapsed().as_secs_f64(),
+            }),
+        );
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&Value::Object(out))?);
+        return Ok(());
+    }
+    println!(
+        "{} on {} (N = {n}, {sets} sets), I = {}",
+        f.spec(),
+        source.name(),
+        f.integral()
+    );
+    for (key, extra) in [
+        ("fourier", "truncation_bound"),
+        ("spatial", "stderr"),
+        ("empirical", "ci_low"),
+    ] {
+        if let Some(v) = out.get(key) {
+            let variance = v["variance"]
+                .as_f64()
+                .map_or("n/a".to_string(), |x| format!("{x:.6e}"));
+            let note = match key {
+                "empirical" => format!(
+                    "95% CI [{:.4e}, {:.4e}]",
+                    v["ci_low"].as_f64().unwrap_or(0.0),
+                    v["ci_high"].as_f64().unwrap_or(0.0)
+                ),
+                _ if v.get("skipped").is_some() => {
+                    v["skipped"].as_str().unwrap_or_default().to_string()
+                }
+                _ => format!("{extra} {:.2e}", v[extra].as_f64().unwrap_or(0.0)),
+            };
+            println!("  {key:<10} {variance:>14}  {note}");
+        }
+    }
+    Ok(())
+}

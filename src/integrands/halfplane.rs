@@ -1,0 +1,160 @@
+//! The indicator of the part of the unit square on one side of a line:
+//! P = {x ∈ [0,1)² : (x − p)·n ≥ 0}, n = (cos θ, sin θ), p = (½,½) + offset·n.
+//!
+//! P is a convex polygon. Its transform follows from the divergence theorem
+//! (e.g. Lee & Mittra 1983, "Fourier transform of a polygonal shape
+//! function", IEEE TAP 31(1)): for k ≠ 0,
+//! F(k) = i/(2π|k|²) Σ_edges (k × t_e) · sinc(π k·t_e) · e^(−2πik·m_e),
+//! with t_e the edge vector (counter-clockwise), m_e its midpoint and
+//! k × t = kx·ty − ky·tx. The periodic autocorrelation is a sum of four
+//! overlap areas, each an axis-aligned rectangle cut by one half-plane.
+
+use rustfft::num_complex::Complex64;
+
+use super::{Integrand, IntegrandClass, sinc_pi};
+use crate::spectrum::phase::exp_neg_2pi_i;
+
+/// Half-plane ∩ unit square indicator.
+#[derive(Debug, Clone)]
+pub struct HalfPlane {
+    angle: f64,
+    offset: f64,
+    n: [f64; 2],
+    /// n·p: the half-plane is n·x ≥ level.
+    level: f64,
+    /// (midpoint, edge vector) of each non-degenerate edge, counter-clockwise.
+    edges: Vec<([f64; 2], [f64; 2])>,
+    area: f64,
+}
+
+impl HalfPlane {
+    /// The half-plane at `angle` degrees and signed `offset` from the centre.
+    pub fn new(angle: f64, offset: f64) -> Self {
+        let (s, c) = angle.to_radians().sin_cos();
+        let n = [c, s];
+        let level = 0.5 * (c + s) + offset;
+        let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let polygon = clip(&square, n, level);
+        let area = shoelace(&polygon);
+        let edges = (0..polygon.len())
+            .map(|i| (polygon[i], polygon[(i + 1) % polygon.len()]))
+            .map(|(a, b)| {
+                (
+                    [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])],
+                    [b[0] - a[0], b[1] - a[1]],
+                )
+            })
+            .filter(|(_, t)| t[0] != 0.0 || t[1] != 0.0)
+            .collect();
+        HalfPlane {
+            angle,
+            offset,
+            n,
+            level,
+            edges,
+            area,
+        }
+    }
+}
+
+/// The convex polygon `poly` (counter-clockwise) clipped to n·x ≥ level
+/// (one Sutherland–Hodgman pass).
+fn clip(poly: &[[f64; 2]], n: [f64; 2], level: f64) -> Vec<[f64; 2]> {
+    let side = |p: [f64; 2]| p[0] * n[0] + p[1] * n[1] - level;
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (sa, sb) = (side(a), side(b));
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        if (sa >= 0.0) != (sb >= 0.0) {
+            let t = sa / (sa - sb);
+            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+        }
+    }
+    out
+}
+
+/// Area of a simple polygon (counter-clockwise positive).
+fn shoelace(poly: &[[f64; 2]]) -> f64 {
+    let n = poly.len();
+    0.5 * (0..n)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum::<f64>()
+}
+
+impl Integrand for HalfPlane {
+    fn dim(&self) -> usize {
+        2
+    }
+
+    fn integral(&self) -> f64 {
+        self.area
+    }
+
+    fn variance(&self) -> f64 {
+        self.area * (1.0 - self.area)
+    }
+
+    fn eval(&self, x: &[f64]) -> f64 {
+        if x[0] * self.n[0] + x[1] * self.n[1] >= self.level {
+            1.0
+        } else {
+            0.0
+        }
+    }
+
+    fn fourier(&self, k: &[i64]) -> Complex64 {
+        if k[0] == 0 && k[1] == 0 {
+            return Complex64::new(self.area, 0.0);
+        }
+        let (kx, ky) = (k[0] as f64, k[1] as f64);
+        let sum = self
+            .edges
+            .iter()
+            .fold(Complex64::new(0.0, 0.0), |acc, (m, t)| {
+                let cross = kx * t[1] - ky * t[0];
+                acc + exp_neg_2pi_i(k, m) * (cross * sinc_pi(kx.mul_add(t[0], ky * t[1])))
+            });
+        sum * Complex64::new(0.0, 1.0 / (std::f64::consts::TAU * (kx * kx + ky * ky)))
+    }
+
+    fn autocov(&self, h: &[f64]) -> Option<f64> {
+        // ∫ f(x) f(x+h) over the torus: for t = h + m ∈ (−1,1)², the overlap
+        // P ∩ (P + t) is the rectangle [0,1]² ∩ ([0,1]² + t) cut by
+        // n·x ≥ level + max(0, n·t).
+        let h = [h[0] - h[0].floor(), h[1] - h[1].floor()];
+        let mut overlap = 0.0;
+        for mx in [-1.0, 0.0] {
+            for my in [-1.0, 0.0] {
+                let t = [h[0] + mx, h[1] + my];
+                let (x0, x1) = (t[0].max(0.0), (1.0 + t[0]).min(1.0));
+                let (y0, y1) = (t[1].max(0.0), (1.0 + t[1]).min(1.0));
+                if x1 > x0 && y1 > y0 {
+                    let level = self.level + (self.n[0] * t[0] + self.n[1] * t[1]).max(0.0);
+                    let rect = [[x0, y0], [x1, y0], [x1, y1], [x0, y1]];
+                    overlap += shoelace(&clip(&rect, self.n, level));
+                }
+            }
+        }
+        Some(overlap - self.area * self.area)
+    }
+
+    fn class(&self) -> IntegrandClass {
+        IntegrandClass {
+            smooth: false,
+            one_axis: self.n[0] == 0.0
+                || self.n[1] == 0.0
+                || self.n[0].abs() == 1.0
+                || self.n[1].abs() == 1.0,
+        }
+    }
+
+    fn spec(&self) -> String {
+        format!("halfplane:angle={},offset={}", self.angle, self.offset)
+    }
+}

@@ -1,0 +1,129 @@
+//! Reference integrands with exact integral, Fourier coefficients and (in
+//! 2D) periodic autocovariance (DESIGN.md §1).
+//!
+//! Every integrand is a function on the unit torus; F_f(k) are its Fourier
+//! coefficients, P_f(k) = |F_f(k)|², and
+//! c_f(h) = ∫ f(x) f(x+h) dx − I² = Σ_(k≠0) P_f(k) e^(2πik·h) its periodic
+//! autocovariance, evaluated in closed form where the geometry allows, never
+//! as a difference of nearly equal large numbers.
+
+mod cos;
+mod defocus;
+mod disk;
+mod gaussian;
+mod halfplane;
+mod rect;
+mod spec;
+
+pub use cos::Cosine;
+pub use defocus::{Defocus, DefocusShape};
+pub use disk::Disk;
+pub use gaussian::Gaussian;
+pub use halfplane::HalfPlane;
+pub use rect::Rect;
+pub use spec::{INTEGRANDS, IntegrandInfo, parse};
+
+use rustfft::num_complex::Complex64;
+
+/// A test integrand on the unit torus.
+pub trait Integrand: Send + Sync {
+    /// Dimension d.
+    fn dim(&self) -> usize;
+    /// The exact integral I = F_f(0).
+    fn integral(&self) -> f64;
+    /// The variance of f under uniform sampling, ∫f² − I² = c_f(0) =
+    /// Σ_(k≠0) P_f(k), computed without cancellation.
+    fn variance(&self) -> f64;
+    /// f(x) for x in [0,1)^d.
+    fn eval(&self, x: &[f64]) -> f64;
+    /// The Fourier coefficient F_f(k) = ∫ f(x) e^(−2πik·x) dx.
+    fn fourier(&self, k: &[i64]) -> Complex64;
+    /// The periodic autocovariance c_f(h), or `None` where no closed form is
+    /// implemented (4D integrands).
+    fn autocov(&self, h: &[f64]) -> Option<f64>;
+    /// Radius beyond which c_f(h) = −I² exactly (the autocorrelation has
+    /// compact support there), if any: lets the spatial predictor visit only
+    /// close pairs and count the rest exactly.
+    fn autocov_support(&self) -> Option<f64> {
+        None
+    }
+    /// Smoothness and axis structure, for the theoretical convergence rate.
+    fn class(&self) -> IntegrandClass;
+    /// The canonical spec string, e.g. `disk:r=0.3,cx=0.5,cy=0.5`.
+    fn spec(&self) -> String;
+}
+
+/// What the convergence theory needs to know of an integrand
+/// (Pilleboue et al. 2015, Table 1; DESIGN.md §1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IntegrandClass {
+    /// C^∞ (Gaussian, cosine) rather than discontinuous (indicators).
+    pub smooth: bool,
+    /// Varies along one coordinate axis only (e.g. `box:w=1`): N-rooks then
+    /// behaves like 1D jitter.
+    pub one_axis: bool,
+}
+
+/// What is wrong with an integrand spec.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IntegrandError {
+    /// No integrand of that name.
+    #[error("unknown integrand `{name}`; known: {known}")]
+    Unknown {
+        /// The name.
+        name: String,
+        /// Known names.
+        known: String,
+    },
+    /// A key the integrand does not take.
+    #[error("{integrand}: unknown parameter `{key}`; its parameters: {known}")]
+    UnknownKey {
+        /// Integrand name.
+        integrand: &'static str,
+        /// The key.
+        key: String,
+        /// Its keys.
+        known: String,
+    },
+    /// Malformed `key=value` text.
+    #[error("integrand spec `{spec}`: `{part}` is not key=value")]
+    Syntax {
+        /// The whole spec.
+        spec: String,
+        /// The offending part.
+        part: String,
+    },
+    /// A value out of its domain.
+    #[error("{integrand}: {key}={value} is invalid: expected {expected}")]
+    Value {
+        /// Integrand name.
+        integrand: &'static str,
+        /// The key.
+        key: &'static str,
+        /// The value text.
+        value: String,
+        /// What is accepted.
+        expected: String,
+    },
+}
+
+/// sin(x)/x, 1 at 0.
+#[inline]
+pub(crate) fn sinc(x: f64) -> f64 {
+    if x.abs() < 1e-4 {
+        1.0 - x * x / 6.0
+    } else {
+        x.sin() / x
+    }
+}
+
+/// sin(πu)/(πu) for an exactly rounded u, reducing u modulo 2 exactly
+/// before the sine so large |u| keeps its accuracy.
+#[inline]
+pub(crate) fn sinc_pi(u: f64) -> f64 {
+    if u.abs() <= 1.0 {
+        return sinc(std::f64::consts::PI * u);
+    }
+    let r = u - 2.0 * (0.5 * u).round();
+    (std::f64::consts::PI * r).sin() / (std::f64::consts::PI * u)
+}

@@ -1,0 +1,263 @@
+//! Parsing `name:key=value,...` integrand specs, and the registry that
+//! `varspec integrands --list` prints.
+
+use super::{
+    Cosine, Defocus, DefocusShape, Disk, Gaussian, HalfPlane, Integrand, IntegrandError, Rect,
+};
+
+/// A registered integrand.
+pub struct IntegrandInfo {
+    /// Name.
+    pub name: &'static str,
+    /// Dimension.
+    pub dim: usize,
+    /// What it is.
+    pub summary: &'static str,
+    /// (key, default, meaning).
+    pub params: &'static [(&'static str, &'static str, &'static str)],
+}
+
+/// Every integrand.
+pub const INTEGRANDS: &[IntegrandInfo] = &[
+    IntegrandInfo {
+        name: "cos",
+        dim: 2,
+        summary: "f = 1 + cos(2π k·x): a finite spectrum (P_f = 1/4 at ±k)",
+        params: &[
+            ("kx", "1", "integer frequency, x"),
+            ("ky", "0", "integer frequency, y"),
+        ],
+    },
+    IntegrandInfo {
+        name: "disk",
+        dim: 2,
+        summary: "indicator of a disk (periodic images): F = r J1(2πr|k|)/|k| e^(−2πik·c)",
+        params: &[
+            ("r", "0.3", "radius in (0, 0.5]"),
+            ("cx", "0.5", "centre x"),
+            ("cy", "0.5", "centre y"),
+        ],
+    },
+    IntegrandInfo {
+        name: "box",
+        dim: 2,
+        summary: "indicator of a rotated rectangle: product of sincs; c_f a product of triangles",
+        params: &[
+            (
+                "w",
+                "0.5",
+                "side along the first axis (cos θ, sin θ), in (0, 1]",
+            ),
+            ("h", "0.25", "side along the second axis, in (0, 1]"),
+            ("cx", "0.5", "centre x"),
+            ("cy", "0.5", "centre y"),
+            ("angle", "0", "θ in degrees, counter-clockwise"),
+        ],
+    },
+    IntegrandInfo {
+        name: "gaussian",
+        dim: 2,
+        summary: "periodized Gaussian bump of peak 1",
+        params: &[
+            (
+                "sx",
+                "0.1",
+                "standard deviation along the first axis, in (0, 0.5]",
+            ),
+            (
+                "sy",
+                "sx",
+                "standard deviation along the second axis, in (0, 0.5]",
+            ),
+            ("angle", "0", "θ in degrees, counter-clockwise"),
+            ("cx", "0.5", "centre x"),
+            ("cy", "0.5", "centre y"),
+        ],
+    },
+    IntegrandInfo {
+        name: "halfplane",
+        dim: 2,
+        summary: "indicator of {x in the unit square: (x − p)·n ≥ 0}, n = (cos θ, sin θ), p = (½,½) + offset·n",
+        params: &[
+            ("angle", "0", "θ in degrees"),
+            ("offset", "0", "signed distance of the edge from the centre"),
+        ],
+    },
+    IntegrandInfo {
+        name: "defocus",
+        dim: 4,
+        summary: "thin-lens light field f(x,y,u,v) = g(x + c(u−½), y + c(v−½)); energy on a sheared plane",
+        params: &[
+            (
+                "shape",
+                "box",
+                "g: box (side size), disk (diameter size) or gaussian (4σ = size), centred at (½,½)",
+            ),
+            ("size", "0.3", "see shape, in (0, 1]"),
+            ("c", "0", "shear c = (F − d)/d"),
+        ],
+    },
+];
+
+/// Key-value parameters of one spec, checked against the registry.
+struct Params {
+    info: &'static IntegrandInfo,
+    pairs: Vec<(String, String)>,
+}
+
+impl Params {
+    fn text(&self, key: &'static str) -> &str {
+        self.pairs
+            .iter()
+            .rev()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
+            .or_else(|| self.info.params.iter().find(|p| p.0 == key).map(|p| p.1))
+            .expect("registered key")
+    }
+
+    fn given(&self, key: &str) -> bool {
+        self.pairs.iter().any(|(k, _)| k == key)
+    }
+
+    fn bad(&self, key: &'static str, expected: &str) -> IntegrandError {
+        IntegrandError::Value {
+            integrand: self.info.name,
+            key,
+            value: self.text(key).to_string(),
+            expected: expected.to_string(),
+        }
+    }
+
+    /// A finite number satisfying `ok`, else an error quoting `expected`.
+    fn number(
+        &self,
+        key: &'static str,
+        ok: impl Fn(f64) -> bool,
+        expected: &str,
+    ) -> Result<f64, IntegrandError> {
+        self.text(key)
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && ok(*v))
+            .ok_or_else(|| self.bad(key, expected))
+    }
+
+    fn integer(&self, key: &'static str) -> Result<i64, IntegrandError> {
+        self.text(key)
+            .parse::<i64>()
+            .ok()
+            .filter(|v| v.abs() <= 1 << 40)
+            .ok_or_else(|| self.bad(key, "an integer (the integrand must be periodic)"))
+    }
+
+    fn centre(&self) -> Result<[f64; 2], IntegrandError> {
+        Ok([
+            self.number("cx", |_| true, "a number")?,
+            self.number("cy", |_| true, "a number")?,
+        ])
+    }
+}
+
+/// Parses `name:key=value,...` (or just `name`) into an integrand.
+///
+/// # Errors
+/// [`IntegrandError`] for an unknown name or key, malformed text, or a value
+/// outside its domain (r > 0.5, negative sizes, NaN, …).
+pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
+    let (name, rest) = spec.split_once(':').unwrap_or((spec, ""));
+    let name = name.trim();
+    let info =
+        INTEGRANDS
+            .iter()
+            .find(|i| i.name == name)
+            .ok_or_else(|| IntegrandError::Unknown {
+                name: name.to_string(),
+                known: INTEGRANDS
+                    .iter()
+                    .map(|i| i.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+    let mut pairs = Vec::new();
+    for part in rest.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (k, v) = part.split_once('=').ok_or_else(|| IntegrandError::Syntax {
+            spec: spec.to_string(),
+            part: part.to_string(),
+        })?;
+        let k = k.trim();
+        if !info.params.iter().any(|p| p.0 == k) {
+            return Err(IntegrandError::UnknownKey {
+                integrand: info.name,
+                key: k.to_string(),
+                known: info
+                    .params
+                    .iter()
+                    .map(|p| p.0)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
+        pairs.push((k.to_string(), v.trim().to_string()));
+    }
+    let p = Params { info, pairs };
+    let unit = |v: f64| v > 0.0 && v <= 1.0;
+    Ok(match info.name {
+        "cos" => Box::new(Cosine::new([p.integer("kx")?, p.integer("ky")?])),
+        "disk" => Box::new(Disk::new(
+            p.number("r", |r| r > 0.0 && r <= 0.5, "a radius in (0, 0.5]")?,
+            p.centre()?,
+        )),
+        "box" => {
+            let (w, h) = (
+                p.number("w", unit, "a side in (0, 1]")?,
+                p.number("h", unit, "a side in (0, 1]")?,
+            );
+            let angle = p.number("angle", |_| true, "an angle in degrees")?;
+            Rect::new(w, h, p.centre()?, angle)
+                .map_err(|e| p.bad("angle", &e))?
+                .boxed()
+        }
+        "gaussian" => {
+            let sx = p.number(
+                "sx",
+                |s| s > 0.0 && s <= 0.5,
+                "a standard deviation in (0, 0.5]",
+            )?;
+            let sy = if p.given("sy") {
+                p.number(
+                    "sy",
+                    |s| s > 0.0 && s <= 0.5,
+                    "a standard deviation in (0, 0.5]",
+                )?
+            } else {
+                sx
+            };
+            Box::new(Gaussian::new(
+                sx,
+                sy,
+                p.number("angle", |_| true, "an angle in degrees")?,
+                p.centre()?,
+            ))
+        }
+        "halfplane" => Box::new(HalfPlane::new(
+            p.number("angle", |_| true, "an angle in degrees")?,
+            p.number("offset", |o| o.abs() <= 1.0, "an offset in [-1, 1]")?,
+        )),
+        "defocus" => {
+            let shape = match p.text("shape") {
+                "box" => DefocusShape::Box,
+                "disk" => DefocusShape::Disk,
+                "gaussian" => DefocusShape::Gaussian,
+                _ => return Err(p.bad("shape", "box, disk or gaussian")),
+            };
+            let size = p.number("size", unit, "a size in (0, 1]")?;
+            Box::new(Defocus::new(
+                shape,
+                size,
+                p.number("c", |c| c.abs() <= 16.0, "a shear in [-16, 16]")?,
+            ))
+        }
+        _ => unreachable!("every registered integrand is built above"),
+    })
+}

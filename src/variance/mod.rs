@@ -1,0 +1,68 @@
+//! Three independent predictors of Var[Î] for the shift-randomized
+//! estimator Î(s) = (1/N) Σ_j f(x_j + s mod 1) (DESIGN.md §1), which must
+//! agree: [`spatial`] (exact, to rounding), [`fourier`] (within its reported
+//! truncation bound) and [`empirical`] (within its confidence interval);
+//! and the convergence-rate fit ([`convergence`]).
+//!
+//! Realizations are handed in as a function r ↦ point set (sets of a file,
+//! or fresh draws of a sampler with stream (seed, r)), so sampler-level
+//! predictions average the same realizations in every method.
+
+pub mod convergence;
+pub mod empirical;
+pub mod fourier;
+pub mod spatial;
+pub mod sum;
+
+pub use convergence::{SlopeFit, fit_slope, theoretical_rate};
+pub use empirical::{EmpiricalEstimate, empirical};
+pub use fourier::{FourierEstimate, fourier};
+pub use spatial::{SpatialEstimate, spatial, spatial_variance};
+
+use crate::samplers::SamplerError;
+use crate::spectrum::SpectrumError;
+
+/// What stops a prediction.
+#[derive(Debug, thiserror::Error)]
+pub enum VarianceError {
+    /// Points and integrand differ in dimension.
+    #[error("the integrand is {integrand}-dimensional, the points are {points}-dimensional")]
+    Dimension {
+        /// Integrand dimension.
+        integrand: usize,
+        /// Point dimension.
+        points: usize,
+    },
+    /// The spatial form needs a closed-form autocovariance.
+    #[error(
+        "the spatial predictor needs the integrand's autocovariance c_f, which {spec} does not have in closed form"
+    )]
+    NoAutocovariance {
+        /// The integrand.
+        spec: String,
+    },
+    /// Realizations of different sizes in a Fourier prediction.
+    #[error("the Fourier predictor needs every set to have the same N (found {first} and {other})")]
+    MixedSizes {
+        /// One size.
+        first: usize,
+        /// Another.
+        other: usize,
+    },
+    /// Too few realizations for a variance.
+    #[error("{what} needs at least {needed} realizations, got {got}")]
+    TooFew {
+        /// The estimate.
+        what: &'static str,
+        /// Required.
+        needed: usize,
+        /// Given.
+        got: usize,
+    },
+    /// A sampler failed to produce a realization.
+    #[error(transparent)]
+    Sampler(#[from] SamplerError),
+    /// The spectrum could not be computed.
+    #[error(transparent)]
+    Spectrum(#[from] SpectrumError),
+}
