@@ -4,6 +4,7 @@
 mod args;
 mod bench;
 mod compare;
+mod converge;
 mod integrands;
 mod pcf;
 mod plot;
@@ -40,6 +41,8 @@ enum Command {
     /// Variance of the shift-randomized estimator: Fourier, spatial and
     /// empirical predictors side by side.
     Predict(predict::Args),
+    /// Variance against N, the fitted log-log slope with its CI, and theory.
+    Converge(converge::Args),
     /// The reference integrands and their parameters.
     Integrands(integrands::Args),
     /// Benchmarks that print speed against error.
@@ -61,6 +64,7 @@ pub fn main() -> ExitCode {
         Command::Pcf(a) => pcf::run(a),
         Command::Bench(c) => bench::run(c),
         Command::Predict(a) => predict::run(a),
+        Command::Converge(a) => converge::run(a),
         Command::Integrands(a) => integrands::run(a),
     };
     match result {

@@ -113,8 +113,37 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
     macro_rules! finish {
         ($chart:expr) => {{
             let mut chart = $chart;
+            let axis_number = |v: &f64| {
+                if plot.log_log {
+                    let e = v.abs().log10();
+                    if (e - e.round()).abs() < 1e-9 {
+                        format!("1e{}", e.round())
+                    } else {
+                        String::new()
+                    }
+                } else {
+                    format!("{}", (v * 1e6).round() / 1e6)
+                }
+            };
+            // On a log axis label only 1, 2 and 5 times powers of ten.
+            let x_number = |v: &f64| {
+                if !plot.log_log {
+                    return axis_number(v);
+                }
+                let mantissa = v / 10f64.powf(v.log10().floor());
+                let shown = [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-6);
+                if shown {
+                    format!("{}", v.round())
+                } else {
+                    String::new()
+                }
+            };
             chart
                 .configure_mesh()
+                .x_labels(10)
+                .y_labels(10)
+                .x_label_formatter(&x_number)
+                .y_label_formatter(&axis_number)
                 .x_desc(plot.x_label.as_str())
                 .y_desc(plot.y_label.as_str())
                 .label_style(("sans-serif", 15))
