@@ -82,7 +82,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "fourier".into(),
             json!({
                 "variance": e.variance, "truncation_bound": e.truncation_bound, "in_box": e.in_box,
-                "tail": e.tail, "res": res, "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
+                "tail": e.tail, "stderr": e.stderr, "res": res, "sets": e.sets,
+                "seconds": start.elapsed().as_secs_f64(),
             }),
         );
     }

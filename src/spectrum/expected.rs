@@ -99,6 +99,27 @@ pub fn expected_power<E>(
 where
     E: From<SpectrumError> + Send,
 {
+    expected_power_with(freqs, method, sets, realization, &|_| 0.0, on_set_done).map(|(s, _)| s)
+}
+
+/// As [`expected_power`], and also `statistic(power_r)` of every
+/// realization's own power spectrum N·P_S (box order), returned in
+/// realization order — e.g. its inner product with an integrand's P_f, for
+/// per-set variances and their standard error.
+///
+/// # Errors
+/// As [`expected_power`].
+pub fn expected_power_with<E>(
+    freqs: FrequencyBox,
+    method: Method,
+    sets: usize,
+    realization: impl Fn(usize) -> Result<PointSet, E> + Sync,
+    statistic: &(dyn Fn(&[f64]) -> f64 + Sync),
+    on_set_done: &(dyn Fn() + Sync),
+) -> Result<(Spectrum, Vec<f64>), E>
+where
+    E: From<SpectrumError> + Send,
+{
     if sets == 0 {
         return Err(SpectrumError::NoSets.into());
     }
@@ -107,17 +128,20 @@ where
         Method::Direct => None,
     };
     let len = freqs.len();
-    let chunks: Vec<Vec<f64>> = (0..sets.div_ceil(CHUNK))
+    let chunks: Vec<(Vec<f64>, Vec<f64>)> = (0..sets.div_ceil(CHUNK))
         .into_par_iter()
         .map_init(
             || {
+                let zero = Complex64::new(0.0, 0.0);
                 (
                     plan.as_ref().map(NufftPlan::make_scratch),
-                    vec![Complex64::new(0.0, 0.0); len],
+                    vec![zero; len],
+                    vec![0.0; len],
                 )
             },
-            |(scratch, s), c| -> Result<Vec<f64>, E> {
+            |(scratch, s, power), c| -> Result<(Vec<f64>, Vec<f64>), E> {
                 let mut sum = vec![0.0; len];
+                let mut stats = Vec::with_capacity(CHUNK);
                 for r in c * CHUNK..((c + 1) * CHUNK).min(sets) {
                     let points = realization(r)?;
                     if points.dim() != freqs.dim {
@@ -134,23 +158,27 @@ where
                         _ => s.copy_from_slice(&dft::sample_spectrum(&points, &freqs)),
                     }
                     let n = points.len().max(1) as f64;
-                    for (acc, v) in sum.iter_mut().zip(s.iter()) {
-                        *acc += v.norm_sqr() / n;
+                    for ((acc, p), v) in sum.iter_mut().zip(power.iter_mut()).zip(s.iter()) {
+                        *p = v.norm_sqr() / n;
+                        *acc += *p;
                     }
+                    stats.push(statistic(power));
                     on_set_done();
                 }
-                Ok(sum)
+                Ok((sum, stats))
             },
         )
         .collect::<Result<_, E>>()?;
     let mut power = vec![0.0; len];
-    for chunk in &chunks {
+    let mut stats = Vec::with_capacity(sets);
+    for (chunk, chunk_stats) in &chunks {
         for (p, v) in power.iter_mut().zip(chunk) {
             *p += v;
         }
+        stats.extend_from_slice(chunk_stats);
     }
     for p in &mut power {
         *p /= sets as f64;
     }
-    Ok(Spectrum { freqs, power, sets })
+    Ok((Spectrum { freqs, power, sets }, stats))
 }

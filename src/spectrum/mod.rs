@@ -11,7 +11,7 @@ pub mod pcf;
 pub mod phase;
 pub mod radial;
 
-pub use expected::{Method, Spectrum, expected_power};
+pub use expected::{Method, Spectrum, expected_power, expected_power_with};
 pub use frequencies::FrequencyBox;
 pub use nufft::{NufftPlan, Sign};
 

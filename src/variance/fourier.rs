@@ -5,16 +5,21 @@
 //! far from DC for non-lattice samplers.
 //!
 //! The error of that tail is Σ_(k∉B) (N·E[P_S(k)] − 1)·P_f(k)/N. It is
-//! bounded from the outer shell of B (|k|∞ > h/2), where the deviation
-//! δ(k) = N·P_S(k) − 1 is observed: a bias term |mean δ|·T/N plus three
-//! standard deviations of a fluctuation term, sd δ·√(T·max P_f)/N (using
-//! Σ_(k∉B) P_f² ≤ max P_f · T), with T the tail mass and max P_f taken over
-//! the shell. Lattices (regular grids) show large δ in the shell and get a
-//! correspondingly large bound: when some shell frequency carries more than
-//! 20× the white-noise power (impossible for an averaged non-lattice
+//! estimated from the outer shell of B (|k|∞ > h/2), where the deviation
+//! δ(k) = N·P_S(k) − 1 is observed, weighting each frequency by the
+//! integrand's P_f(k) so that structure shared by both spectra counts (an
+//! N-rooks set has δ ≈ −1 on the axes, where a half-plane's square edges put
+//! their energy). The bound is a bias term max(2|μ_w|, |μ|)·T/N — the
+//! P_f-weighted mean deviation doubled for the extrapolation beyond the
+//! shell, or the plain mean — plus three weighted standard deviations of a
+//! fluctuation term, σ_w·√(T·max P_f)/N (using Σ_(k∉B) P_f² ≤ max P_f · T),
+//! with T the tail mass and max P_f taken over the shell. Lattices (regular
+//! grids) show large δ in the shell: when some shell frequency carries more
+//! than 20× the white-noise power (impossible for an averaged non-lattice
 //! spectrum: a single periodogram's maximum over 10⁵ frequencies is about
 //! 12), the tail is bounded by max|δ|·T/N instead, the worst case the shell
-//! shows.
+//! shows. The bound is an estimate from the data, not a theorem: it assumes
+//! the shell represents the frequencies beyond it.
 
 use rayon::prelude::*;
 
@@ -22,7 +27,7 @@ use super::VarianceError;
 use super::sum::NeumaierSum;
 use crate::integrands::Integrand;
 use crate::points::PointSet;
-use crate::spectrum::{FrequencyBox, Method, expected_power};
+use crate::spectrum::{FrequencyBox, Method, expected_power_with};
 
 /// Shell deviation |N·P_S − 1| above which the spectrum is treated as a
 /// lattice's (see the module doc).
@@ -33,6 +38,8 @@ const LATTICE_SPIKE: f64 = 20.0;
 pub struct FourierEstimate {
     /// Σ_(k∈B\0) E[P_S] P_f + tail/N.
     pub variance: f64,
+    /// Standard error of `variance` over realizations (0 for one).
+    pub stderr: f64,
     /// Bound on the error of the tail term (see the module doc).
     pub truncation_bound: f64,
     /// The part from inside the box.
@@ -85,7 +92,19 @@ where
             points: first.dim(),
         });
     }
-    let spectrum = expected_power(
+    let pf = integrand_power(f, &freqs);
+    let zero = freqs.zero_index();
+    // Each realization's in-box sum Σ_(k≠0) N·P_S(k)·P_f(k), for the standard error.
+    let in_box_of = |power: &[f64]| {
+        let mut s = NeumaierSum::default();
+        for (idx, (&p, &w)) in power.iter().zip(&pf).enumerate() {
+            if idx != zero {
+                s.add(p * w);
+            }
+        }
+        s.value()
+    };
+    let (spectrum, per_set) = expected_power_with(
         freqs,
         Method::Fast { tolerance },
         sets,
@@ -99,9 +118,9 @@ where
             }
             Ok(set)
         },
+        &in_box_of,
         &|| {},
     )?;
-    let pf = integrand_power(f, &freqs);
     let zero = freqs.zero_index();
     let (mut in_box, mut mass) = (NeumaierSum::default(), NeumaierSum::default());
     // Shell statistics of δ = power − 1 (two passes) and max P_f there.
@@ -131,12 +150,17 @@ where
     } else {
         let m = shell.len() as f64;
         let mean = shell.iter().map(|s| s.0).sum::<f64>() / m;
-        let sd = (shell.iter().map(|s| (s.0 - mean).powi(2)).sum::<f64>() / m).sqrt();
-        (
-            mean.abs(),
-            sd,
-            shell.iter().map(|s| s.1).fold(0.0, f64::max),
-        )
+        let weight: f64 = shell.iter().map(|s| s.1).sum();
+        let (mean_w, sd_w) = if weight > 0.0 {
+            let mw = shell.iter().map(|s| s.0 * s.1).sum::<f64>() / weight;
+            let var = shell.iter().map(|s| s.1 * (s.0 - mw).powi(2)).sum::<f64>() / weight;
+            (mw, var.sqrt())
+        } else {
+            let sd = (shell.iter().map(|s| (s.0 - mean).powi(2)).sum::<f64>() / m).sqrt();
+            (mean, sd)
+        };
+        let pf_max = shell.iter().map(|s| s.1).fold(0.0, f64::max);
+        ((2.0 * mean_w.abs()).max(mean.abs()), sd_w, pf_max)
     };
     let worst = shell.iter().map(|s| s.0.abs()).fold(0.0, f64::max);
     let truncation_bound = if worst > LATTICE_SPIKE {
@@ -146,8 +170,10 @@ where
     };
     let in_box = in_box.value() / nf;
     let tail = tail_mass / nf;
+    let (_, stderr) = super::spatial::mean_and_stderr(&per_set);
     Ok(FourierEstimate {
         variance: in_box + tail,
+        stderr: stderr / nf,
         truncation_bound,
         in_box,
         tail,

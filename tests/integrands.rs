@@ -1,0 +1,202 @@
+//! Integrands: spectra and autocovariances checked against independent
+//! computations, the spec parser's errors.
+
+use rustfft::num_complex::Complex64;
+use varspec::integrands::{self, Integrand, IntegrandError};
+
+fn parse(spec: &str) -> Box<dyn Integrand> {
+    integrands::parse(spec).unwrap_or_else(|e| panic!("{spec}: {e}"))
+}
+
+/// F(k) by the M×M midpoint rule on eval. For an indicator the error is at
+/// most the measure of the cells the boundary crosses, ≤ 2·perimeter/M
+/// (each crossed cell mis-weights by at most its area 1/M², and a curve of
+/// length L crosses at most 2L·M cells); for smooth periodic integrands the
+/// rule is spectrally accurate.
+fn quadrature(f: &dyn Integrand, k: [i64; 2], m: usize) -> Complex64 {
+    let mut sum = Complex64::new(0.0, 0.0);
+    for i in 0..m {
+        for j in 0..m {
+            let x = [(i as f64 + 0.5) / m as f64, (j as f64 + 0.5) / m as f64];
+            let v = f.eval(&x);
+            if v != 0.0 {
+                sum += varspec::spectrum::phase::exp_neg_2pi_i(&k, &x) * v;
+            }
+        }
+    }
+    sum / (m * m) as f64
+}
+
+#[test]
+fn fourier_coefficients_match_quadrature() {
+    let m = 1024;
+    let cases: [(&str, f64); 6] = [
+        (
+            "disk:r=0.3,cx=0.4,cy=0.55",
+            2.0 * std::f64::consts::PI * 0.3,
+        ),
+        ("box:w=0.5,h=0.25,angle=30,cx=0.45", 1.5),
+        ("halfplane:angle=17,offset=0.07", 4.0),
+        ("halfplane:angle=45,offset=0", 4.0),
+        ("gaussian:sx=0.1,sy=0.05,angle=20,cx=0.3", 0.0),
+        ("cos:kx=3,ky=-2", 0.0),
+    ];
+    for (spec, perimeter) in cases {
+        let f = parse(spec);
+        let tol = if perimeter > 0.0 {
+            2.0 * perimeter / m as f64
+        } else {
+            1e-12
+        };
+        for k in [[0, 0], [1, 0], [0, 1], [3, -2], [-5, 7], [11, 4]] {
+            let exact = f.fourier(&k);
+            let numeric = quadrature(f.as_ref(), k, m);
+            assert!(
+                (exact - numeric).norm() <= tol,
+                "{spec} k={k:?}: {exact} vs quadrature {numeric} (tol {tol:e})"
+            );
+        }
+    }
+}
+
+#[test]
+fn axis_aligned_halfplane_is_a_box() {
+    // Two independent transforms: polygon edges vs product of sincs.
+    for (angle, offset) in [(0.0, 0.1), (90.0, -0.2), (180.0, 0.05), (270.0, 0.0)] {
+        let hp = parse(&format!("halfplane:angle={angle},offset={offset}"));
+        let width = 0.5 - offset;
+        let (n, c) = match angle as i64 {
+            0 => ([1.0, 0.0], [1.0 - width / 2.0, 0.5]),
+            90 => ([0.0, 1.0], [0.5, 1.0 - width / 2.0]),
+            180 => ([-1.0, 0.0], [width / 2.0, 0.5]),
+            _ => ([0.0, -1.0], [0.5, width / 2.0]),
+        };
+        let (w, h) = if n[0] != 0.0 {
+            (width, 1.0)
+        } else {
+            (1.0, width)
+        };
+        let rect = parse(&format!("box:w={w},h={h},cx={},cy={}", c[0], c[1]));
+        assert!((hp.integral() - rect.integral()).abs() < 1e-15);
+        for k in [[1, 0], [0, 1], [2, 3], [-7, 1], [40, -33], [1000, 1]] {
+            let (a, b) = (hp.fourier(&k), rect.fourier(&k));
+            assert!((a - b).norm() < 1e-13, "angle {angle} k={k:?}: {a} vs {b}");
+        }
+        for h in [[0.1, 0.2], [0.7, 0.05], [0.5, 0.5], [0.0, 0.3]] {
+            let (a, b) = (hp.autocov(&h).unwrap(), rect.autocov(&h).unwrap());
+            assert!((a - b).abs() < 1e-14, "angle {angle} h={h:?}: {a} vs {b}");
+        }
+    }
+}
+
+/// c_f(h) = Σ_(k≠0) P_f(k) cos(2πk·h); truncated to |k|∞ ≤ K the series
+/// misses at most the tail mass c_f(0) − Σ_(k∈B\0) P_f(k) (Parseval), a
+/// rigorous tolerance.
+#[test]
+fn autocovariance_matches_its_fourier_series_within_the_tail_mass() {
+    let kmax = 100i64;
+    for spec in [
+        "disk:r=0.3,cx=0.4,cy=0.55",
+        "disk:r=0.5",
+        "box:w=0.5,h=0.25,angle=30",
+        "box:w=1,h=0.3",
+        "halfplane:angle=17,offset=0.07",
+        "gaussian:sx=0.1,sy=0.05,angle=20",
+        "gaussian:sx=0.3,sy=0.25",
+        "cos:kx=3,ky=2",
+    ] {
+        let f = parse(spec);
+        let mut powers = Vec::new();
+        for kx in -kmax..=kmax {
+            for ky in -kmax..=kmax {
+                if (kx, ky) != (0, 0) {
+                    powers.push(([kx, ky], f.fourier(&[kx, ky]).norm_sqr()));
+                }
+            }
+        }
+        let mass: f64 = powers.iter().map(|p| p.1).sum();
+        let tail = (f.variance() - mass).max(0.0);
+        assert!(
+            (f.autocov(&[0.0, 0.0]).unwrap() - f.variance()).abs() < 1e-14,
+            "{spec}: c(0) != variance"
+        );
+        for h in [
+            [0.0, 0.0],
+            [0.13, 0.71],
+            [0.5, 0.5],
+            [0.9, 0.02],
+            [0.31, 0.3],
+        ] {
+            let series: f64 = powers
+                .iter()
+                .map(|(k, p)| {
+                    p * (std::f64::consts::TAU * (k[0] as f64 * h[0] + k[1] as f64 * h[1])).cos()
+                })
+                .sum();
+            let c = f.autocov(&h).unwrap();
+            assert!(
+                (c - series).abs() <= tail + 1e-12,
+                "{spec} h={h:?}: c = {c}, series = {series}, tail {tail:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn defocus_energy_lies_on_the_sheared_plane() {
+    let f = parse("defocus:shape=box,size=0.3,c=0.6");
+    let g = parse("box:w=0.3,h=0.3");
+    // On the plane ku = c·kx (c·kx an integer) the sinc is 1: |F| = |G|.
+    for (kx, ky) in [(5, 0), (10, -5), (0, 0)] {
+        let k = [kx, ky, (0.6 * kx as f64) as i64, (0.6 * ky as f64) as i64];
+        assert!((f.fourier(&k).norm() - g.fourier(&[kx, ky]).norm()).abs() < 1e-15);
+    }
+    // Off the plane by one integer step in ku, sinc(π(ku − c kx)) at a
+    // nonzero integer argument vanishes.
+    assert!(f.fourier(&[5, 0, 4, 0]).norm() < 1e-15);
+    assert_eq!(f.autocov(&[0.1, 0.2, 0.3, 0.4]), None);
+    assert!((f.variance() - g.variance()).abs() < 1e-15);
+    // Evaluation follows the shear: x + c(u − ½).
+    assert_eq!(f.eval(&[0.5, 0.5, 0.5, 0.5]), 1.0);
+    assert_eq!(f.eval(&[0.5 - 0.6 * 0.4, 0.5, 0.9, 0.5]), 1.0);
+    assert_eq!(f.eval(&[0.5, 0.5, 0.9, 0.5]), 0.0);
+}
+
+#[test]
+fn bad_specs_are_clear_errors() {
+    let err = |s: &str| {
+        integrands::parse(s)
+            .err()
+            .unwrap_or_else(|| panic!("{s} should fail"))
+    };
+    assert!(matches!(
+        err("sphere:r=0.1"),
+        IntegrandError::Unknown { .. }
+    ));
+    assert!(matches!(
+        err("disk:radius=0.1"),
+        IntegrandError::UnknownKey { .. }
+    ));
+    assert!(matches!(err("disk:r"), IntegrandError::Syntax { .. }));
+    for (spec, phrase) in [
+        ("disk:r=0.6", "(0, 0.5]"),
+        ("disk:r=-0.1", "(0, 0.5]"),
+        ("disk:r=NaN", "(0, 0.5]"),
+        ("box:w=-0.5", "(0, 1]"),
+        ("box:w=0.9,h=0.9,angle=45", "periodic images"),
+        ("gaussian:sx=0", "(0, 0.5]"),
+        ("cos:kx=1.5", "integer"),
+        ("defocus:shape=star", "box, disk or gaussian"),
+        ("halfplane:offset=inf", "[-1, 1]"),
+    ] {
+        let e = err(spec).to_string();
+        assert!(
+            e.contains(phrase),
+            "{spec}: {e:?} should mention {phrase:?}"
+        );
+    }
+    assert_eq!(
+        parse("gaussian:sx=0.2").spec(),
+        "gaussian:sx=0.2,sy=0.2,angle=0,cx=0.5,cy=0.5"
+    );
+}
