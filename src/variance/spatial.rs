@@ -130,7 +130,9 @@ pub fn spatial_variance(points: &PointSet, f: &dyn Integrand) -> Result<(f64, f6
     v.add(2.0 * off_diagonal);
     let n2 = n as f64 * n as f64;
     let rounding = 4.0 * f64::EPSILON * (n as f64 * c0.abs() + 2.0 * off_abs) / n2;
-    Ok((v.value() / n2, rounding))
+    // A variance is non-negative; a negative total is rounding noise, within
+    // `rounding` of 0.
+    Ok(((v.value() / n2).max(0.0), rounding))
 }
 
 /// The spatial prediction averaged over `sets` realizations.

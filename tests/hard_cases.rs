@@ -1,0 +1,197 @@
+//! Numerical stability on hard cases (issue 4): degenerate and extreme
+//! parameters give finite, non-negative variances on which the predictors
+//! agree, or a stated reason why one does not apply.
+
+use varspec::PointSet;
+use varspec::integrands;
+use varspec::rng::set_rng;
+use varspec::samplers;
+use varspec::variance::{VarianceError, empirical, fourier, spatial};
+
+/// z for the empirical comparisons (per-check two-sided rate 6.8e-6).
+const Z: f64 = 4.5;
+
+struct Agreement {
+    spatial: f64,
+    fourier: f64,
+    empirical: f64,
+}
+
+/// All three predictors on one fixed set (shifts only), checked against
+/// each other; returns the values for further checks.
+fn agree_on(set: &PointSet, spec: &str, half: usize, realizations: usize) -> Agreement {
+    let f = integrands::parse(spec).unwrap();
+    let one = |_: usize| -> Result<PointSet, VarianceError> { Ok(set.clone()) };
+    let s = spatial(f.as_ref(), 1, one).unwrap();
+    let four = fourier(f.as_ref(), half, 1e-12, 1, one).unwrap();
+    let e = empirical(f.as_ref(), realizations, 3, one).unwrap();
+    for (name, v) in [
+        ("spatial", s.variance),
+        ("fourier", four.variance),
+        ("empirical", e.variance),
+    ] {
+        assert!(v.is_finite() && v >= 0.0, "{spec}: {name} variance {v}");
+    }
+    assert!(
+        (four.variance - s.variance).abs()
+            <= four.truncation_bound + s.rounding_bound + 1e-12 * f.variance(),
+        "{spec} N={}: fourier {:e} vs spatial {:e}, bound {:e} + rounding {:e}",
+        set.len(),
+        four.variance,
+        s.variance,
+        four.truncation_bound,
+        s.rounding_bound
+    );
+    let se = (e.ci_high - e.ci_low) / (2.0 * 1.959_964);
+    assert!(
+        (e.variance - s.variance).abs() <= Z * se + s.rounding_bound,
+        "{spec} N={}: empirical {:e} [{:e}, {:e}] vs spatial {:e}",
+        set.len(),
+        e.variance,
+        e.ci_low,
+        e.ci_high,
+        s.variance
+    );
+    Agreement {
+        spatial: s.variance,
+        fourier: four.variance,
+        empirical: e.variance,
+    }
+}
+
+fn jitter(n: usize, seed: u64) -> PointSet {
+    samplers::build("jitter", n, Some(2), &[])
+        .unwrap()
+        .sample(&mut set_rng(seed, 0))
+        .unwrap()
+}
+
+#[test]
+fn tiny_disk_at_65536_points() {
+    // 0.2 points fall in the disk on average: Î is nearly a Bernoulli.
+    let set = jitter(65_536, 1);
+    let a = agree_on(&set, "disk:r=1e-3,cx=0.3,cy=0.6", 63, 2000);
+    assert!(a.spatial > 0.0);
+}
+
+#[test]
+fn hairline_box_at_one_degree() {
+    agree_on(&jitter(1024, 2), "box:w=1e-3,h=0.9,angle=1", 127, 20_000);
+}
+
+#[test]
+fn gaussian_with_axis_ratio_1000() {
+    agree_on(
+        &jitter(1024, 3),
+        "gaussian:sx=0.1,sy=1e-4,angle=30",
+        127,
+        20_000,
+    );
+}
+
+#[test]
+fn halfplanes_at_degenerate_angles_and_through_corners() {
+    for spec in [
+        "halfplane:angle=0,offset=0.13",
+        "halfplane:angle=45,offset=0.1",
+        "halfplane:angle=1e-9,offset=0.2",
+        "halfplane:angle=45,offset=0",
+        "halfplane:angle=90,offset=-0.5",
+    ] {
+        agree_on(&jitter(256, 4), spec, 127, 20_000);
+    }
+    // Through the corner (1,1) only: the polygon is a point, f = 0.
+    let a = agree_on(
+        &jitter(256, 4),
+        "halfplane:angle=45,offset=0.7071067811865476",
+        31,
+        100,
+    );
+    assert!(a.spatial < 1e-15 && a.fourier < 1e-15 && a.empirical == 0.0);
+}
+
+#[test]
+fn cosine_at_frequency_4000_3000() {
+    // k₀ lies far outside the box: the Fourier form is all tail and wide.
+    let set = jitter(1024, 5);
+    let a = agree_on(&set, "cos:kx=4000,ky=3000", 31, 20_000);
+    // Spatial exactly: ½·N·P_S(k₀)/N with S from the exact direct sum.
+    let exact = {
+        let mut acc = rustfft::num_complex::Complex64::new(0.0, 0.0);
+        for p in set.points() {
+            acc += varspec::spectrum::phase::exp_neg_2pi_i(&[4000, 3000], p);
+        }
+        0.5 * acc.norm_sqr() / (1024.0 * 1024.0)
+    };
+    assert!(
+        (a.spatial - exact).abs() <= 1e-12 * exact.max(1e-300) + 1e-18,
+        "{} vs {exact}",
+        a.spatial
+    );
+}
+
+#[test]
+fn variance_1e14_below_the_squared_integral() {
+    // A regular grid integrates a smooth bump almost exactly: Var/I² ~ 3e-15.
+    let set = samplers::build("regular", 256, Some(2), &[])
+        .unwrap()
+        .sample(&mut set_rng(0, 0))
+        .unwrap();
+    let f = integrands::parse("gaussian:sx=0.1,sy=0.05,angle=20").unwrap();
+    let a = agree_on(&set, &f.spec(), 127, 4000);
+    let i2 = f.integral() * f.integral();
+    assert!(
+        a.fourier / i2 < 1e-13 && a.fourier > 0.0,
+        "relative variance {}",
+        a.fourier / i2
+    );
+}
+
+#[test]
+fn one_two_and_duplicate_points() {
+    let f = integrands::parse("disk:r=0.3").unwrap();
+    for n in [1, 4] {
+        let a = agree_on(&jitter(n, 6), "disk:r=0.3", 127, 20_000);
+        assert!(a.spatial <= f.variance() + 1e-15);
+    }
+    let two = PointSet::new(2, vec![0.1, 0.2, 0.6, 0.7]).unwrap();
+    agree_on(&two, "box:w=0.5,h=0.25,angle=30", 127, 20_000);
+    // Four copies of one point integrate like one point: Var = c_f(0).
+    let dup = PointSet::new(2, vec![0.3, 0.4, 0.3, 0.4, 0.3, 0.4, 0.3, 0.4]).unwrap();
+    let a = agree_on(&dup, "disk:r=0.3", 127, 20_000);
+    assert!((a.spatial - f.variance()).abs() < 1e-15);
+}
+
+#[test]
+fn defocus_has_no_spatial_form_and_says_so() {
+    let f = integrands::parse("defocus:shape=disk,size=0.3,c=0.6").unwrap();
+    let set = samplers::build("umj", 64, Some(4), &[])
+        .unwrap()
+        .sample(&mut set_rng(0, 0))
+        .unwrap();
+    let err = spatial(f.as_ref(), 1, |_| -> Result<PointSet, VarianceError> {
+        Ok(set.clone())
+    })
+    .unwrap_err();
+    assert!(err.to_string().contains("closed form"), "{err}");
+    let four = fourier(
+        f.as_ref(),
+        7,
+        1e-9,
+        4,
+        |_| -> Result<PointSet, VarianceError> { Ok(set.clone()) },
+    )
+    .unwrap();
+    let e = empirical(
+        f.as_ref(),
+        20_000,
+        1,
+        |_| -> Result<PointSet, VarianceError> { Ok(set.clone()) },
+    )
+    .unwrap();
+    let se = (e.ci_high - e.ci_low) / (2.0 * 1.959_964);
+    assert!(
+        (four.variance - e.variance).abs() <= four.truncation_bound + Z * se,
+        "{four:?} vs {e:?}"
+    );
+}
