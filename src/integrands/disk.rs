@@ -80,10 +80,14 @@ impl Integrand for Disk {
         let (hx, hy) = (nearest_image(h[0]), nearest_image(h[1]));
         let mut overlap = 0.0;
         // With r ≤ ½ only images within one period can overlap.
+        let reach2 = 4.0 * self.r * self.r;
         for mx in -1..=1 {
             for my in -1..=1 {
                 let (dx, dy) = (hx + mx as f64, hy + my as f64);
-                overlap += self.lens((dx * dx + dy * dy).sqrt());
+                let d2 = dx * dx + dy * dy;
+                if d2 < reach2 {
+                    overlap += self.lens(d2.sqrt());
+                }
             }
         }
         Some(overlap - self.area() * self.area())

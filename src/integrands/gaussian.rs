@@ -61,12 +61,19 @@ impl Gaussian {
         a * a / (self.sx * self.sx) + b * b / (self.sy * self.sy)
     }
 
-    /// Σ_m exp(−scale·form(u + m)) over images, skipping negligible ones.
+    /// Σ_m exp(−scale·form(u + m)) over images, skipping negligible ones:
+    /// form(v) ≥ |v|²/s_max², so only |u_j + m_j| ≤ s_max·√(CUTOFF/scale)
+    /// along each axis can contribute.
     fn image_sum(&self, u: [f64; 2], scale: f64) -> f64 {
         let (ux, uy) = (nearest_image(u[0]), nearest_image(u[1]));
+        let reach = self.sx.max(self.sy) * (CUTOFF / scale).sqrt();
+        let range = |v: f64| {
+            ((-reach - v).ceil() as i64).max(-self.images)
+                ..=((reach - v).floor() as i64).min(self.images)
+        };
         let mut sum = 0.0;
-        for mx in -self.images..=self.images {
-            for my in -self.images..=self.images {
+        for mx in range(ux) {
+            for my in range(uy) {
                 let q = scale * self.form([ux + mx as f64, uy + my as f64]);
                 if q < CUTOFF {
                     sum += (-q).exp();
