@@ -7,16 +7,30 @@ use std::time::Instant;
 use clap::Subcommand;
 use rustfft::num_complex::Complex64;
 
+use varspec::integrands;
 use varspec::io::write_atomic;
 use varspec::rng::set_rng;
 use varspec::samplers;
 use varspec::spectrum::dft::sample_spectrum;
 use varspec::spectrum::{FrequencyBox, Method, NufftPlan, Sign, SpectrumError, expected_power};
+use varspec::variance::{VarianceError, empirical, fourier, spatial_variance};
 
 #[derive(Subcommand)]
 pub enum BenchCommand {
     /// Spectrum: direct vs fast (NUFFT) time and error at several tolerances.
     Spectrum(SpectrumArgs),
+    /// Variance predictors: time and error against the exact spatial form.
+    Predict(PredictArgs),
+}
+
+#[derive(clap::Args)]
+pub struct PredictArgs {
+    /// CSV of the table.
+    #[arg(long, default_value = "results/bench-predict.csv")]
+    csv: PathBuf,
+    /// Skip R = 1e5 empirical runs and N = 4096.
+    #[arg(long)]
+    quick: bool,
 }
 
 #[derive(clap::Args)]
@@ -32,6 +46,7 @@ pub struct SpectrumArgs {
 pub fn run(c: BenchCommand) -> anyhow::Result<()> {
     match c {
         BenchCommand::Spectrum(a) => spectrum(a),
+        BenchCommand::Predict(a) => predict(a),
     }
 }
 
@@ -193,6 +208,52 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
                 opt(r.max_power_error),
                 opt(r.max_rel_error)
             )?;
+        }
+        Ok(())
+    })?;
+    println!("wrote {}", a.csv.display());
+    Ok(())
+}
+
+fn predict(a: PredictArgs) -> anyhow::Result<()> {
+    let threads = rayon::current_num_threads();
+    println!("variance predictors: time and relative error against the exact spatial form, {threads} threads");
+    println!("one jittered set per row group, shift-randomized estimator");
+    println!("{:<40} {:<26} {:>10} {:>12} {:>11}", "case", "method", "seconds", "variance", "rel. error");
+    let mut lines = vec!["case,method,seconds,variance,relative_error,threads".to_string()];
+    let ns: &[usize] = if a.quick { &[1024] } else { &[1024, 4096] };
+    for &n in ns {
+        let set = samplers::build("jitter", n, Some(2), &[])?.sample(&mut set_rng(11, 0))?;
+        for spec in ["disk:r=0.3", "halfplane:angle=17,offset=0.07"] {
+            let f = integrands::parse(spec)?;
+            let case = format!("jitter N={n}, {spec}");
+            let (secs, exact) = time(3, || spatial_variance(&set, f.as_ref()));
+            let (exact, rounding) = exact?;
+            let mut row = |method: String, seconds: f64, variance: f64| {
+                let rel = (variance - exact) / exact;
+                println!("{case:<40} {method:<26} {seconds:>10.4} {variance:>12.5e} {rel:>11.2e}");
+                lines.push(format!("\"{case}\",\"{method}\",{seconds},{variance:e},{rel:e},{threads}"));
+            };
+            row(format!("spatial (rounding {rounding:.0e})"), secs, exact);
+            for res in [64, 128, 256, 512] {
+                let one = |_: usize| -> Result<_, VarianceError> { Ok(set.clone()) };
+                let (secs, e) = time(3, || fourier(f.as_ref(), res / 2 - 1, 1e-10, 1, one));
+                let e = e?;
+                row(format!("fourier K={res} + tail"), secs, e.variance);
+                row(format!("fourier K={res}, no tail"), secs, e.in_box);
+            }
+            let counts: &[usize] = if a.quick { &[1_000, 10_000] } else { &[1_000, 10_000, 100_000] };
+            for &r in counts {
+                let lend = |_: usize| -> Result<&_, VarianceError> { Ok(&set) };
+                let (secs, e) = time(1, || empirical(f.as_ref(), r, 5, lend));
+                let e = e?;
+                row(format!("empirical R={r} (CI ±{:.0}%)", 50.0 * (e.ci_high - e.ci_low) / exact), secs, e.variance);
+            }
+        }
+    }
+    write_atomic(&a.csv, |w| {
+        for l in &lines {
+            writeln!(w, "{l}")?;
         }
         Ok(())
     })?;

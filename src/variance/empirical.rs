@@ -48,18 +48,20 @@ fn estimate(f: &dyn Integrand, set: &PointSet, shift: &[f64]) -> f64 {
 }
 
 /// The empirical variance of Î over R realizations; realization r is
-/// `realization(r)`, shifted by a uniform s drawn from stream (seed, r).
+/// `realization(r)` (owned or borrowed: a fixed set can be lent R times),
+/// shifted by a uniform s drawn from stream (seed, r).
 ///
 /// # Errors
 /// [`VarianceError`] for R < 2, a dimension mismatch or a failing
 /// realization.
-pub fn empirical<E>(
+pub fn empirical<P, E>(
     f: &dyn Integrand,
     realizations: usize,
     seed: u64,
-    realization: impl Fn(usize) -> Result<PointSet, E> + Sync,
+    realization: impl Fn(usize) -> Result<P, E> + Sync,
 ) -> Result<EmpiricalEstimate, VarianceError>
 where
+    P: std::borrow::Borrow<PointSet>,
     VarianceError: From<E>,
     E: Send,
 {
@@ -75,6 +77,7 @@ where
         .into_par_iter()
         .map(|r| {
             let set = realization(r)?;
+            let set = set.borrow();
             if set.dim() != d || d > 4 {
                 return Err(VarianceError::Dimension {
                     integrand: d,
@@ -83,7 +86,7 @@ where
             }
             let mut rng = set_rng(seed ^ SHIFT_STREAM, r as u64);
             let shift: Vec<f64> = (0..d).map(|_| uniform(&mut rng)).collect();
-            Ok(estimate(f, &set, &shift))
+            Ok(estimate(f, set, &shift))
         })
         .collect::<Result<_, VarianceError>>()?;
     let r = realizations as f64;
