@@ -217,9 +217,14 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
 
 fn predict(a: PredictArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
-    println!("variance predictors: time and relative error against the exact spatial form, {threads} threads");
+    println!(
+        "variance predictors: time and relative error against the exact spatial form, {threads} threads"
+    );
     println!("one jittered set per row group, shift-randomized estimator");
-    println!("{:<40} {:<26} {:>10} {:>12} {:>11}", "case", "method", "seconds", "variance", "rel. error");
+    println!(
+        "{:<40} {:<26} {:>10} {:>12} {:>11}",
+        "case", "method", "seconds", "variance", "rel. error"
+    );
     let mut lines = vec!["case,method,seconds,variance,relative_error,threads".to_string()];
     let ns: &[usize] = if a.quick { &[1024] } else { &[1024, 4096] };
     for &n in ns {
@@ -232,7 +237,9 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
             let mut row = |method: String, seconds: f64, variance: f64| {
                 let rel = (variance - exact) / exact;
                 println!("{case:<40} {method:<26} {seconds:>10.4} {variance:>12.5e} {rel:>11.2e}");
-                lines.push(format!("\"{case}\",\"{method}\",{seconds},{variance:e},{rel:e},{threads}"));
+                lines.push(format!(
+                    "\"{case}\",\"{method}\",{seconds},{variance:e},{rel:e},{threads}"
+                ));
             };
             row(format!("spatial (rounding {rounding:.0e})"), secs, exact);
             for res in [64, 128, 256, 512] {
@@ -242,12 +249,23 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
                 row(format!("fourier K={res} + tail"), secs, e.variance);
                 row(format!("fourier K={res}, no tail"), secs, e.in_box);
             }
-            let counts: &[usize] = if a.quick { &[1_000, 10_000] } else { &[1_000, 10_000, 100_000] };
+            let counts: &[usize] = if a.quick {
+                &[1_000, 10_000]
+            } else {
+                &[1_000, 10_000, 100_000]
+            };
             for &r in counts {
                 let lend = |_: usize| -> Result<&_, VarianceError> { Ok(&set) };
                 let (secs, e) = time(1, || empirical(f.as_ref(), r, 5, lend));
                 let e = e?;
-                row(format!("empirical R={r} (CI ±{:.0}%)", 50.0 * (e.ci_high - e.ci_low) / exact), secs, e.variance);
+                row(
+                    format!(
+                        "empirical R={r} (CI ±{:.0}%)",
+                        50.0 * (e.ci_high - e.ci_low) / exact
+                    ),
+                    secs,
+                    e.variance,
+                );
             }
         }
     }

@@ -5,6 +5,7 @@ mod args;
 mod bench;
 mod compare;
 mod converge;
+mod experiment;
 mod integrands;
 mod pcf;
 mod plot;
@@ -43,6 +44,8 @@ enum Command {
     Predict(predict::Args),
     /// Variance against N, the fitted log-log slope with its CI, and theory.
     Converge(converge::Args),
+    /// Run a declarative experiment file and write its tables to results/.
+    Experiment(experiment::Args),
     /// The reference integrands and their parameters.
     Integrands(integrands::Args),
     /// Benchmarks that print speed against error.
@@ -65,6 +68,7 @@ pub fn main() -> ExitCode {
         Command::Bench(c) => bench::run(c),
         Command::Predict(a) => predict::run(a),
         Command::Converge(a) => converge::run(a),
+        Command::Experiment(a) => experiment::run(a),
         Command::Integrands(a) => integrands::run(a),
     };
     match result {

@@ -1,0 +1,260 @@
+//! `varspec predict`, `converge`, `integrands` and `experiment` as scripts
+//! use them: the JSON keys of DESIGN.md §2, errors, determinism.
+
+use std::process::{Command, Output};
+
+fn varspec(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args(args)
+        .output()
+        .expect("the varspec binary runs")
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = varspec(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("one JSON object")
+}
+
+#[test]
+fn predict_json_has_the_contract_keys_and_the_methods_agree() {
+    let v = json(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "256",
+        "--integrand",
+        "disk:r=0.3",
+        "--sets",
+        "8",
+        "--realizations",
+        "4000",
+        "--json",
+    ]);
+    let i = v["integral"].as_f64().unwrap();
+    assert!((i - std::f64::consts::PI * 0.09).abs() < 1e-15);
+    let (f, s, e) = (&v["fourier"], &v["spatial"], &v["empirical"]);
+    let fv = f["variance"].as_f64().unwrap();
+    let sv = s["variance"].as_f64().unwrap();
+    assert!(
+        (fv - sv).abs()
+            <= f["truncation_bound"].as_f64().unwrap() + s["rounding_bound"].as_f64().unwrap()
+    );
+    assert!(e["ci_low"].as_f64().unwrap() <= e["variance"].as_f64().unwrap());
+    assert!(e["ci_high"].as_f64().unwrap() >= e["variance"].as_f64().unwrap());
+    assert_eq!(e["realizations"].as_u64(), Some(4000));
+    // A point-set file works through --points, and a 4D integrand without
+    // a closed-form autocovariance says why the spatial form is skipped.
+    let dir = std::env::temp_dir().join(format!("varspec-clivar-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("umj.csv");
+    assert!(
+        varspec(&[
+            "sample",
+            "umj",
+            "-n",
+            "64",
+            "--sets",
+            "2",
+            "-o",
+            file.to_str().unwrap()
+        ])
+        .status
+        .success()
+    );
+    let v = json(&[
+        "predict",
+        "--points",
+        file.to_str().unwrap(),
+        "--integrand",
+        "defocus:shape=box,size=0.3,c=0.6",
+        "--json",
+        "--realizations",
+        "500",
+    ]);
+    assert!(v["spatial"]["variance"].is_null());
+    assert!(
+        v["spatial"]["skipped"]
+            .as_str()
+            .unwrap()
+            .contains("closed form")
+    );
+    assert!(v["fourier"]["variance"].as_f64().unwrap() > 0.0);
+    let only = json(&[
+        "predict",
+        "--points",
+        file.to_str().unwrap(),
+        "--dims",
+        "0,2",
+        "--integrand",
+        "disk:r=0.2",
+        "--method",
+        "spatial",
+        "--json",
+    ]);
+    assert!(only.get("fourier").is_none() && only["spatial"]["variance"].as_f64().unwrap() > 0.0);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn predict_output_does_not_depend_on_thread_count() {
+    let run = |threads: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
+            .args([
+                "predict",
+                "--sampler",
+                "cmj",
+                "-n",
+                "100",
+                "--integrand",
+                "box:w=0.3,h=0.6,angle=10",
+                "--sets",
+                "20",
+            ])
+            .args(["--realizations", "3000", "--json"])
+            .env("RAYON_NUM_THREADS", threads)
+            .output()
+            .unwrap();
+        let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        for k in ["fourier", "spatial", "empirical"] {
+            v[k].as_object_mut().unwrap().remove("seconds");
+        }
+        v
+    };
+    assert_eq!(run("1"), run("2"));
+}
+
+#[test]
+fn converge_json_reports_slope_and_interval() {
+    let v = json(&[
+        "converge",
+        "--sampler",
+        "jitter",
+        "--integrand",
+        "disk:r=0.3",
+        "--n",
+        "60,256,1024",
+        "--sets",
+        "8",
+        "--json",
+    ]);
+    let slope = v["slope"].as_f64().unwrap();
+    let ci = v["slope_ci"].as_array().unwrap();
+    assert!(ci[0].as_f64().unwrap() <= slope && slope <= ci[1].as_f64().unwrap());
+    assert_eq!(v["theory"].as_f64(), Some(-1.5));
+    assert_eq!(
+        v["points"][0]["n"].as_u64(),
+        Some(64),
+        "60 is not a square: the nearest valid N is used"
+    );
+    assert!(v["adjusted_n"][0].as_str().unwrap().contains("60 -> 64"));
+}
+
+#[test]
+fn bad_requests_fail_clearly() {
+    for (args, phrase) in [
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "256",
+                "--integrand",
+                "disk:r=0.7",
+            ],
+            "(0, 0.5]",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "256",
+                "--integrand",
+                "blob",
+            ],
+            "unknown integrand",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "250",
+                "--integrand",
+                "disk:r=0.3",
+            ],
+            "225 or 256",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "umj",
+                "-n",
+                "64",
+                "--integrand",
+                "disk:r=0.3",
+            ],
+            "choose a projection with --dims",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "64",
+                "--integrand",
+                "disk",
+                "--realizations",
+                "1",
+            ],
+            "at least 2",
+        ),
+        (
+            vec![
+                "converge",
+                "--sampler",
+                "jitter",
+                "--integrand",
+                "disk",
+                "--n",
+                "64",
+            ],
+            "at least two",
+        ),
+        (
+            vec!["experiment", "/nonexistent/exp.json"],
+            "/nonexistent/exp.json",
+        ),
+    ] {
+        let out = varspec(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(
+            err.contains(phrase),
+            "{args:?}: {err:?} should contain {phrase:?}"
+        );
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn integrands_list_names_every_integrand() {
+    let out = String::from_utf8(varspec(&["integrands", "--list"]).stdout).unwrap();
+    for i in varspec::integrands::INTEGRANDS {
+        assert!(out.contains(i.name), "{} missing", i.name);
+        for (key, _, _) in i.params {
+            assert!(out.contains(&format!("{key}=")));
+        }
+    }
+}
