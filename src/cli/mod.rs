@@ -7,6 +7,7 @@ mod compare;
 mod converge;
 mod experiment;
 mod integrands;
+mod optimize;
 mod pcf;
 mod plot;
 mod predict;
@@ -46,6 +47,9 @@ enum Command {
     Converge(converge::Args),
     /// Run a declarative experiment file and write its tables to results/.
     Experiment(experiment::Args),
+    /// Optimizers: point positions toward a target spectrum.
+    #[command(subcommand)]
+    Optimize(optimize::OptimizeCommand),
     /// The reference integrands and their parameters.
     Integrands(integrands::Args),
     /// Benchmarks that print speed against error.
@@ -69,6 +73,7 @@ pub fn main() -> ExitCode {
         Command::Predict(a) => predict::run(a),
         Command::Converge(a) => converge::run(a),
         Command::Experiment(a) => experiment::run(a),
+        Command::Optimize(c) => optimize::run(c),
         Command::Integrands(a) => integrands::run(a),
     };
     match result {

@@ -406,7 +406,7 @@ fn kernel(z: f64, beta: f64) -> f64 {
 /// ψ̂(ξ) = ∫ ψ(u) e^(−2πiξu) du = (w/2) ∫_(−1)^(1) φ(z) cos(π w ξ z) dz, by
 /// Gauss–Legendre quadrature with enough nodes for double precision.
 fn kernel_transform(xi: f64, width: usize, beta: f64) -> f64 {
-    let (nodes, weights) = gauss_legendre(4 * width + 40);
+    let (nodes, weights) = crate::quadrature::gauss_legendre(4 * width + 40);
     let w = width as f64;
     let sum: f64 = nodes
         .iter()
@@ -414,36 +414,6 @@ fn kernel_transform(xi: f64, width: usize, beta: f64) -> f64 {
         .map(|(&z, &q)| q * kernel(z, beta) * (std::f64::consts::PI * w * xi * z).cos())
         .sum();
     0.5 * w * sum
-}
-
-/// Nodes and weights of q-point Gauss–Legendre quadrature on [−1, 1]: roots
-/// of P_q by Newton's method from z ≈ cos(π(i − ¼)/(q + ½)), weights
-/// 2/((1 − z²) P_q'(z)²) (Abramowitz & Stegun 25.4.29).
-fn gauss_legendre(q: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut nodes = Vec::with_capacity(q);
-    let mut weights = Vec::with_capacity(q);
-    for i in 1..=q {
-        let mut z = (std::f64::consts::PI * (i as f64 - 0.25) / (q as f64 + 0.5)).cos();
-        let mut derivative = 0.0;
-        for _ in 0..100 {
-            // P_q(z) by the three-term recurrence; P_q' from P_q and P_(q−1).
-            let (mut p0, mut p1) = (1.0, z);
-            for m in 2..=q {
-                let p2 = ((2 * m - 1) as f64 * z * p1 - (m - 1) as f64 * p0) / m as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            derivative = q as f64 * (z * p1 - p0) / (z * z - 1.0);
-            let step = p1 / derivative;
-            z -= step;
-            if step.abs() < 1e-16 {
-                break;
-            }
-        }
-        nodes.push(z);
-        weights.push(2.0 / ((1.0 - z * z) * derivative * derivative));
-    }
-    (nodes, weights)
 }
 
 /// The smallest 2^a·3^b·5^c ≥ `min` (sizes RustFFT handles fastest).
@@ -464,14 +434,6 @@ fn fine_grid_size(min: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn quadrature_integrates_polynomials_exactly() {
-        let (z, w) = gauss_legendre(10);
-        let integral: f64 = z.iter().zip(&w).map(|(z, w)| w * z.powi(18)).sum();
-        assert!((integral - 2.0 / 19.0).abs() < 1e-14);
-        assert!((w.iter().sum::<f64>() - 2.0).abs() < 1e-14);
-    }
 
     #[test]
     fn grid_sizes_are_even_and_smooth() {

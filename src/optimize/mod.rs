@@ -1,0 +1,43 @@
+//! Optimizers (DESIGN.md §4): gradient descent on point positions to
+//! minimize a weighted spectral loss ([`descent`], weights from
+//! [`target`]), and the shear search for structured 4D sets ([`shear`]).
+
+pub mod descent;
+pub mod target;
+
+pub use descent::{DescentOptions, DescentResult, PointOptimizer};
+pub use target::Target;
+
+/// What stops an optimization.
+#[derive(Debug, thiserror::Error)]
+pub enum OptimizeError {
+    /// A target spec that cannot be used.
+    #[error("target `{spec}`: {reason}")]
+    Target {
+        /// The spec.
+        spec: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A bad option value.
+    #[error("{0}")]
+    Option(String),
+    /// The spectrum plan could not be made.
+    #[error(transparent)]
+    Spectrum(#[from] crate::spectrum::SpectrumError),
+    /// A sampler failed.
+    #[error(transparent)]
+    Sampler(#[from] crate::samplers::SamplerError),
+    /// The integrand spec is invalid.
+    #[error(transparent)]
+    Integrand(#[from] crate::integrands::IntegrandError),
+    /// A point-set problem.
+    #[error(transparent)]
+    PointSet(#[from] crate::points::PointSetError),
+    /// A variance predictor failed.
+    #[error(transparent)]
+    Variance(#[from] crate::variance::VarianceError),
+    /// argmin reported an error.
+    #[error("shear search failed: {0}")]
+    Search(String),
+}

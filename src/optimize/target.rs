@@ -1,0 +1,232 @@
+//! Optimization targets: the weight W(k) of the loss
+//! L(X) = Σ_(0<|k|∞≤K) W(k)·P_S(k) (DESIGN.md §4).
+//!
+//! * an integrand spec: W = P_f, so L is the predicted variance itself
+//!   (within the box);
+//! * `family:disks`: W averaged over disks of radius r ~ U[0.05, 0.45] at
+//!   uniform centres, E_r[(r·J1(2πr|k|)/|k|)²] — isotropic, ∝ |k|^-3 far out:
+//!   a CCVT-like blue-noise target (the centre only changes the phase);
+//! * `power:A`: W = |k|^-A;
+//! * `radial:FILE.csv`: W(|k|) linearly interpolated from columns `k,weight`
+//!   (0 beyond the table).
+
+use std::path::Path;
+
+use rayon::prelude::*;
+
+use super::OptimizeError;
+use crate::integrands;
+use crate::quadrature::integrate_panels;
+use crate::spectrum::FrequencyBox;
+
+/// A parsed target.
+#[derive(Debug, Clone)]
+pub enum Target {
+    /// W = P_f of this integrand.
+    Integrand(String),
+    /// Disks with random centre and radius in [0.05, 0.45].
+    FamilyDisks,
+    /// W = |k|^-A.
+    Power(f64),
+    /// W(|k|) from a table of (k, weight), sorted by k.
+    Radial(Vec<(f64, f64)>),
+}
+
+impl Target {
+    /// Parses `family:disks`, `power:A`, `radial:FILE.csv` or an integrand
+    /// spec.
+    ///
+    /// # Errors
+    /// [`OptimizeError::Target`] naming what is wrong (unknown family, bad
+    /// exponent, unreadable or malformed table with its line), or the
+    /// integrand's own error.
+    pub fn parse(spec: &str) -> Result<Self, OptimizeError> {
+        let fail = |reason: String| OptimizeError::Target {
+            spec: spec.to_string(),
+            reason,
+        };
+        if let Some(family) = spec.strip_prefix("family:") {
+            return match family {
+                "disks" => Ok(Target::FamilyDisks),
+                other => Err(fail(format!("unknown family `{other}` (known: disks)"))),
+            };
+        }
+        if let Some(a) = spec.strip_prefix("power:") {
+            return match a.parse::<f64>() {
+                Ok(a) if a.is_finite() && a > 0.0 => Ok(Target::Power(a)),
+                _ => Err(fail(format!("`{a}` is not a positive exponent"))),
+            };
+        }
+        if let Some(file) = spec.strip_prefix("radial:") {
+            return read_radial(Path::new(file))
+                .map(Target::Radial)
+                .map_err(fail);
+        }
+        integrands::parse(spec)?;
+        Ok(Target::Integrand(spec.to_string()))
+    }
+
+    /// W(k) over the box (box order), W(0) = 0.
+    ///
+    /// # Errors
+    /// An integrand target whose dimension differs from the box's.
+    pub fn weights(&self, freqs: &FrequencyBox) -> Result<Vec<f64>, OptimizeError> {
+        let integrand = match self {
+            Target::Integrand(spec) => {
+                let f = integrands::parse(spec)?;
+                if f.dim() != freqs.dim {
+                    return Err(OptimizeError::Target {
+                        spec: spec.clone(),
+                        reason: format!(
+                            "a {}D integrand cannot weight {}D points",
+                            f.dim(),
+                            freqs.dim
+                        ),
+                    });
+                }
+                Some(f)
+            }
+            _ => None,
+        };
+        let zero = freqs.zero_index();
+        let w: Vec<f64> = (0..freqs.len())
+            .into_par_iter()
+            .map_init(
+                || vec![0i64; freqs.dim],
+                |k, idx| {
+                    if idx == zero {
+                        return 0.0;
+                    }
+                    freqs.frequency(idx, k);
+                    let norm = (k.iter().map(|v| (v * v) as f64).sum::<f64>()).sqrt();
+                    match (self, &integrand) {
+                        (_, Some(f)) => f.fourier(k).norm_sqr(),
+                        (Target::FamilyDisks, _) => disk_family_power(norm),
+                        (Target::Power(a), _) => norm.powf(-a),
+                        (Target::Radial(table), _) => interpolate(table, norm),
+                        (Target::Integrand(_), None) => unreachable!("parsed above"),
+                    }
+                },
+            )
+            .collect();
+        Ok(w)
+    }
+}
+
+/// E_r[(r·J1(2πr|k|)/|k|)²] for r ~ U[0.05, 0.45], by panelled
+/// Gauss–Legendre with a panel per half oscillation of J1² (0.4·|k| of them
+/// over the range).
+fn disk_family_power(k: f64) -> f64 {
+    let panels = 2 + (0.8 * k).ceil() as usize;
+    let mean = integrate_panels(0.05, 0.45, panels, |r| {
+        let j = libm::j1(std::f64::consts::TAU * r * k);
+        r * r * j * j
+    }) / 0.4;
+    mean / (k * k)
+}
+
+fn interpolate(table: &[(f64, f64)], k: f64) -> f64 {
+    match table.iter().position(|&(tk, _)| tk >= k) {
+        Some(0) => table[0].1,
+        Some(i) => {
+            let ((k0, w0), (k1, w1)) = (table[i - 1], table[i]);
+            w0 + (w1 - w0) * (k - k0) / (k1 - k0)
+        }
+        None => 0.0,
+    }
+}
+
+fn read_radial(path: &Path) -> Result<Vec<(f64, f64)>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    match lines.next() {
+        Some((_, h)) if h.replace(' ', "") == "k,weight" => {}
+        _ => {
+            return Err(format!(
+                "{}:1: the header must be `k,weight`",
+                path.display()
+            ));
+        }
+    }
+    let mut table = Vec::new();
+    for (i, line) in lines {
+        let bad = || {
+            format!(
+                "{}:{}: expected two numbers `k,weight` with k increasing and weight >= 0",
+                path.display(),
+                i + 1
+            )
+        };
+        let (k, w) = line.split_once(',').ok_or_else(bad)?;
+        let (k, w): (f64, f64) = (
+            k.trim().parse().map_err(|_| bad())?,
+            w.trim().parse().map_err(|_| bad())?,
+        );
+        if !k.is_finite()
+            || !w.is_finite()
+            || w < 0.0
+            || table.last().is_some_and(|&(pk, _)| k <= pk)
+        {
+            return Err(bad());
+        }
+        table.push((k, w));
+    }
+    if table.is_empty() {
+        return Err(format!("{}: no rows", path.display()));
+    }
+    Ok(table)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disk_family_decays_like_k_cubed() {
+        // Far out J1(z)² averages to 1/(πz): W → E[r]/(2π²|k|³) = 0.25/(2π²k³).
+        for k in [200.0, 400.0] {
+            let ratio =
+                disk_family_power(k) / (0.25 / (2.0 * std::f64::consts::PI.powi(2) * k * k * k));
+            assert!((ratio - 1.0).abs() < 0.02, "k = {k}: ratio {ratio}");
+        }
+        assert!(disk_family_power(1.0) > disk_family_power(5.0));
+    }
+
+    #[test]
+    fn targets_parse_and_refuse() {
+        assert!(matches!(
+            Target::parse("family:disks"),
+            Ok(Target::FamilyDisks)
+        ));
+        assert!(matches!(Target::parse("power:3"), Ok(Target::Power(a)) if a == 3.0));
+        assert!(Target::parse("power:-1").is_err());
+        assert!(
+            Target::parse("family:boxes")
+                .unwrap_err()
+                .to_string()
+                .contains("unknown family")
+        );
+        assert!(
+            Target::parse("radial:/nonexistent.csv")
+                .unwrap_err()
+                .to_string()
+                .contains("/nonexistent.csv")
+        );
+        assert!(matches!(
+            Target::parse("disk:r=0.2"),
+            Ok(Target::Integrand(_))
+        ));
+        assert!(Target::parse("disk:r=0.7").is_err());
+    }
+
+    #[test]
+    fn radial_table_interpolates() {
+        let t = vec![(1.0, 2.0), (3.0, 4.0)];
+        assert_eq!(interpolate(&t, 2.0), 3.0);
+        assert_eq!(interpolate(&t, 0.5), 2.0);
+        assert_eq!(interpolate(&t, 5.0), 0.0);
+    }
+}
