@@ -258,3 +258,83 @@ fn integrands_list_names_every_integrand() {
         }
     }
 }
+
+#[test]
+fn optimize_commands_write_sets_and_reports() {
+    let dir = std::env::temp_dir().join(format!("varspec-cliopt-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (out, report) = (dir.join("bn.csv"), dir.join("bn.json"));
+    let run = varspec(&[
+        "optimize",
+        "points",
+        "-n",
+        "64",
+        "--target",
+        "family:disks",
+        "--sets",
+        "2",
+        "--iters",
+        "100",
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let sets = varspec::io::read_point_sets(&out).unwrap();
+    assert_eq!((sets.len(), sets[0].len()), (2, 64));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(r["loss_curve"].as_array().unwrap().len() > 10 && r["seconds"].as_f64().unwrap() > 0.0);
+    for name in ["optimized", "jitter", "cmj", "sobol", "poisson-disk"] {
+        assert!(
+            r["comparison"][name]["loss"].as_f64().unwrap() > 0.0,
+            "{name} missing from the report"
+        );
+    }
+    let shear = json(&[
+        "optimize",
+        "shear",
+        "--sampler",
+        "umj",
+        "-n",
+        "64",
+        "--integrand",
+        "defocus:shape=box,size=0.3,c=0.6",
+        "--sets",
+        "4",
+        "--realizations",
+        "500",
+        "--json",
+        "-o",
+        dir.join("sheared.csv").to_str().unwrap(),
+    ]);
+    assert_eq!(shear["shear"].as_array().unwrap().len(), 2);
+    for key in ["variance_before", "variance_after"] {
+        for field in ["variance", "ci_low", "ci_high"] {
+            assert!(shear[key][field].as_f64().is_some(), "{key}.{field}");
+        }
+    }
+    assert_eq!(
+        varspec::io::read_point_sets(&dir.join("sheared.csv"))
+            .unwrap()
+            .len(),
+        4
+    );
+    let bad = varspec(&[
+        "optimize",
+        "points",
+        "-n",
+        "64",
+        "--target",
+        "family:boxes",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown family"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

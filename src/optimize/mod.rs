@@ -3,6 +3,7 @@
 //! [`target`]), and the shear search for structured 4D sets ([`shear`]).
 
 pub mod descent;
+pub mod shear;
 pub mod target;
 
 pub use descent::{DescentOptions, DescentResult, PointOptimizer};

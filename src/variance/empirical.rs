@@ -65,6 +65,35 @@ where
     VarianceError: From<E>,
     E: Send,
 {
+    let all: Vec<usize> = (0..f.dim()).collect();
+    empirical_shifting(f, realizations, seed, &all, realization)
+}
+
+/// As [`empirical`], but the random shift moves only the dimensions in
+/// `shift_dims` (none: the unshifted estimator of a randomized sampler,
+/// e.g. sheared multi-jitter, which is unbiased without a shift; DESIGN.md
+/// §4 explains why a shift in u, v would undo a shear).
+///
+/// # Errors
+/// As [`empirical`], plus a shift dimension out of range.
+pub fn empirical_shifting<P, E>(
+    f: &dyn Integrand,
+    realizations: usize,
+    seed: u64,
+    shift_dims: &[usize],
+    realization: impl Fn(usize) -> Result<P, E> + Sync,
+) -> Result<EmpiricalEstimate, VarianceError>
+where
+    P: std::borrow::Borrow<PointSet>,
+    VarianceError: From<E>,
+    E: Send,
+{
+    if let Some(&j) = shift_dims.iter().find(|&&j| j >= f.dim()) {
+        return Err(VarianceError::Dimension {
+            integrand: f.dim(),
+            points: j + 1,
+        });
+    }
     if realizations < 2 {
         return Err(VarianceError::TooFew {
             what: "the empirical predictor",
@@ -85,7 +114,16 @@ where
                 });
             }
             let mut rng = set_rng(seed ^ SHIFT_STREAM, r as u64);
-            let shift: Vec<f64> = (0..d).map(|_| uniform(&mut rng)).collect();
+            let draws: Vec<f64> = (0..d).map(|_| uniform(&mut rng)).collect();
+            let shift: Vec<f64> = (0..d)
+                .map(|j| {
+                    if shift_dims.contains(&j) {
+                        draws[j]
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
             Ok(estimate(f, set, &shift))
         })
         .collect::<Result<_, VarianceError>>()?;

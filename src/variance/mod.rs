@@ -15,7 +15,7 @@ pub mod spatial;
 pub mod sum;
 
 pub use convergence::{SlopeFit, fit_slope, theoretical_rate};
-pub use empirical::{EmpiricalEstimate, empirical};
+pub use empirical::{EmpiricalEstimate, empirical, empirical_shifting};
 pub use fourier::{FourierEstimate, fourier};
 pub use spatial::{SpatialEstimate, spatial, spatial_variance};
 
