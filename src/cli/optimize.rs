@@ -76,7 +76,7 @@ pub struct PointsArgs {
     #[arg(long, default_value_t = 1)]
     sets: usize,
     /// Maximum iterations per set.
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = 1000)]
     iters: usize,
     /// Seed of the starting sets.
     #[arg(long, default_value_t = 0)]
@@ -88,11 +88,11 @@ pub struct PointsArgs {
     /// power laws, 8·N^(1/d) within [32, 128] for integrands).
     #[arg(long)]
     half: Option<usize>,
-    /// NUFFT tolerance of the loss and gradient.
-    #[arg(long, default_value_t = 1e-6)]
+    /// NUFFT tolerance of the loss and gradient (the speed/accuracy knob).
+    #[arg(long, default_value_t = 1e-5)]
     tol: f64,
-    /// Stop when the loss improves by less than this over 50 iterations.
-    #[arg(long, default_value_t = 1e-4)]
+    /// Stop when the loss improves by less than this, relatively, over 50 iterations.
+    #[arg(long, default_value_t = 1e-3)]
     rel_tol: f64,
     /// Output point-set file (CSV).
     #[arg(short = 'o', long = "output")]
@@ -100,6 +100,12 @@ pub struct PointsArgs {
     /// JSON report: loss curve, wall time, loss beside the classic samplers.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// CSV of set 0's loss against wall time: iteration,seconds,loss.
+    #[arg(long)]
+    curve: Option<PathBuf>,
+    /// Log-log PNG of set 0's loss against wall time, with the classic samplers' losses.
+    #[arg(long)]
+    curve_png: Option<PathBuf>,
 }
 
 pub fn run(c: OptimizeCommand) -> anyhow::Result<()> {
@@ -174,12 +180,60 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
             v["loss"].as_f64().unwrap_or(f64::NAN)
         );
     }
+    let curve: Vec<(f64, f64)> = results[0]
+        .seconds
+        .iter()
+        .copied()
+        .zip(results[0].losses.iter().copied())
+        .collect();
+    if let Some(path) = &a.curve {
+        write_atomic(path, |w| {
+            writeln!(w, "iteration,seconds,loss")?;
+            for (i, (t, l)) in curve.iter().enumerate() {
+                writeln!(w, "{i},{t:?},{l:?}")?;
+            }
+            Ok(())
+        })?;
+    }
+    if let Some(path) = &a.curve_png {
+        use varspec::report::plot::{LinePlot, Series, line_plot_png};
+        let (t0, t1) = (
+            curve
+                .iter()
+                .map(|c| c.0)
+                .fold(f64::INFINITY, f64::min)
+                .max(1e-4),
+            curve.last().map_or(1.0, |c| c.0),
+        );
+        let mut series = vec![Series {
+            label: "optimized (set 0)".into(),
+            points: curve.clone(),
+            reference: false,
+        }];
+        for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
+            if let Some(l) = comparison.get(name).and_then(|v| v["loss"].as_f64()) {
+                series.push(Series {
+                    label: name.into(),
+                    points: vec![(t0, l), (t1, l)],
+                    reference: true,
+                });
+            }
+        }
+        let plot = LinePlot {
+            title: format!("loss against time: {} N={}", a.target, a.n),
+            x_label: "seconds".into(),
+            y_label: "loss".into(),
+            log_log: true,
+            series,
+        };
+        line_plot_png(&plot, path)?;
+    }
     if let Some(path) = &a.report {
         let report = json!({
             "target": a.target, "n": a.n, "dim": a.dim, "sets": a.sets, "seed": a.seed, "init": a.init,
             "half": half, "tolerance": a.tol, "seconds": seconds, "iterations": iterations,
             "loss": "sum over 0 < |k|inf <= half of W(k) P_S(k)  (for an integrand target: its predicted variance within the box)",
-            "loss_curve": results[0].losses, "comparison": comparison,
+            "loss_curve": results[0].losses, "loss_curve_seconds": results[0].seconds, "comparison": comparison,
         });
         write_atomic(path, |w| {
             w.write_all(serde_json::to_string_pretty(&report)?.as_bytes())

@@ -71,6 +71,8 @@ pub struct DescentResult {
     pub points: PointSet,
     /// Loss after each iteration (the first entry is the start's).
     pub losses: Vec<f64>,
+    /// Wall time since the start at each entry of `losses`, in seconds.
+    pub seconds: Vec<f64>,
 }
 
 /// A designed descent: box, weights and NUFFT plan, reused for every
@@ -211,11 +213,14 @@ impl PointOptimizer {
         let (mut m, mut v) = (vec![0.0; n * d], vec![0.0; n * d]);
         let mut best = (f64::INFINITY, x.clone());
         let mut losses = Vec::with_capacity(o.iters + 1);
+        let mut seconds = Vec::with_capacity(o.iters + 1);
+        let clock = std::time::Instant::now();
         let mut damping = 1.0;
         for t in 0..o.iters {
             let points = PointSet::new(d, x.clone()).expect("wrapped coordinates lie in [0,1)");
             let (loss, grad) = self.loss_and_gradient(&points, &mut work);
             losses.push(loss);
+            seconds.push(clock.elapsed().as_secs_f64());
             on_iteration(t, loss);
             if loss < best.0 {
                 best = (loss, x.clone());
@@ -244,7 +249,11 @@ impl PointOptimizer {
             }
         }
         let points = PointSet::new(d, best.1).expect("wrapped coordinates lie in [0,1)");
-        DescentResult { points, losses }
+        DescentResult {
+            points,
+            losses,
+            seconds,
+        }
     }
 }
 

@@ -38,6 +38,7 @@ pub struct ShearObjective {
     /// Support frequencies and F_f there.
     support: Vec<([i64; 4], Complex64)>,
     half: i64,
+    evaluations: std::sync::atomic::AtomicU64,
 }
 
 impl ShearObjective {
@@ -82,6 +83,7 @@ impl ShearObjective {
             sets,
             support,
             half: half as i64,
+            evaluations: 0.into(),
         })
     }
 
@@ -90,8 +92,15 @@ impl ShearObjective {
         self.support.len()
     }
 
+    /// Evaluations of J so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
     /// J(a, b).
     pub fn value(&self, a: f64, b: f64) -> f64 {
+        self.evaluations
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let h = self.half;
         let side = (2 * h + 1) as usize;
         let per_set: Vec<f64> = self
@@ -186,18 +195,16 @@ pub fn search_shear(
         .configure(|s| s.max_iters(200))
         .run()
         .map_err(|e| OptimizeError::Search(e.to_string()))?;
+    let evaluations = result
+        .problem
+        .problem
+        .as_ref()
+        .map_or(0, ShearObjective::evaluations);
     let state = result.state();
     let best = state
         .get_best_param()
         .cloned()
         .unwrap_or_else(|| vec![a0, b0]);
-    let evaluations = state
-        .get_func_counts()
-        .get("cost_count")
-        .copied()
-        .unwrap_or(0)
-        + 2 * (steps as u64 + 1)
-        + 1;
     Ok(ShearResult {
         shear: [best[0], best[1]],
         objective: state.get_best_cost(),

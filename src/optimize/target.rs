@@ -89,25 +89,53 @@ impl Target {
             _ => None,
         };
         let zero = freqs.zero_index();
-        let w: Vec<f64> = (0..freqs.len())
-            .into_par_iter()
-            .map_init(
-                || vec![0i64; freqs.dim],
-                |k, idx| {
-                    if idx == zero {
-                        return 0.0;
-                    }
-                    freqs.frequency(idx, k);
-                    let norm = (k.iter().map(|v| (v * v) as f64).sum::<f64>()).sqrt();
-                    match (self, &integrand) {
-                        (_, Some(f)) => f.fourier(k).norm_sqr(),
-                        (Target::FamilyDisks, _) => disk_family_power(norm),
-                        (Target::Power(a), _) => norm.powf(-a),
-                        (Target::Radial(table), _) => interpolate(table, norm),
-                        (Target::Integrand(_), None) => unreachable!("parsed above"),
-                    }
-                },
-            )
+        let squared_norm = |idx: usize, k: &mut [i64]| {
+            freqs.frequency(idx, k);
+            k.iter().map(|v| v * v).sum::<i64>()
+        };
+        if let Some(f) = integrand {
+            let w = (0..freqs.len())
+                .into_par_iter()
+                .map_init(
+                    || vec![0i64; freqs.dim],
+                    |k, idx| {
+                        freqs.frequency(idx, k);
+                        if idx == zero {
+                            0.0
+                        } else {
+                            f.fourier(k).norm_sqr()
+                        }
+                    },
+                )
+                .collect();
+            return Ok(w);
+        }
+        // The other targets are isotropic: evaluate once per distinct |k|².
+        let mut k = vec![0i64; freqs.dim];
+        let mut radii: Vec<i64> = (0..freqs.len())
+            .map(|idx| squared_norm(idx, &mut k))
+            .collect();
+        radii.sort_unstable();
+        radii.dedup();
+        let values: Vec<f64> = radii
+            .par_iter()
+            .map(|&r2| {
+                let norm = (r2 as f64).sqrt();
+                match self {
+                    _ if r2 == 0 => 0.0,
+                    Target::FamilyDisks => disk_family_power(norm),
+                    Target::Power(a) => norm.powf(-a),
+                    Target::Radial(table) => interpolate(table, norm),
+                    Target::Integrand(_) => unreachable!("handled above"),
+                }
+            })
+            .collect();
+        let w = (0..freqs.len())
+            .map(|idx| {
+                values[radii
+                    .binary_search(&squared_norm(idx, &mut k))
+                    .expect("every radius was collected")]
+            })
             .collect();
         Ok(w)
     }

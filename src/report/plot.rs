@@ -132,10 +132,10 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
                 }
                 let mantissa = v / 10f64.powf(v.log10().floor());
                 let shown = [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-6);
-                if shown {
-                    format!("{}", v.round())
-                } else {
-                    String::new()
+                match shown {
+                    false => String::new(),
+                    true if *v >= 10.0 => format!("{}", v.round()),
+                    true => format!("{}", (v * 1e4).round() / 1e4),
                 }
             };
             chart
@@ -152,11 +152,7 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
                 .draw()
                 .map_err(draw_error)?;
             for (i, s) in plot.series.iter().enumerate() {
-                let colour = if s.reference {
-                    RGBColor(120, 120, 120)
-                } else {
-                    PALETTE[i % PALETTE.len()]
-                };
+                let colour = PALETTE[i % PALETTE.len()];
                 let data: Vec<(f64, f64)> = s
                     .points
                     .iter()
