@@ -30,6 +30,7 @@ fn same_seed_gives_identical_bytes_on_one_and_two_threads() {
         ("sobol", "128", vec![]),
         ("halton", "50", vec![]),
         ("nrooks", "33", vec!["-d", "4"]),
+        ("blue-noise", "64", vec!["--param", "iters=50"]),
     ] {
         let mut args = vec!["sample", sampler, "-n", n, "--sets", "16", "--seed", "42"];
         args.extend(extra);

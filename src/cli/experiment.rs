@@ -18,7 +18,6 @@ use serde::Deserialize;
 use super::progress;
 use varspec::integrands;
 use varspec::io::write_atomic;
-use varspec::rng::set_rng;
 use varspec::samplers;
 use varspec::variance::{VarianceError, fit_slope, fourier, spatial, theoretical_rate};
 
@@ -85,14 +84,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (e.samplers.len() * functions.len() * e.n.len()) as u64,
         &e.name,
     );
-    let mut cells = Vec::new();
-    for sampler in &e.samplers {
-        for f in &functions {
-            for &requested in &e.n {
-                let (s, n) = samplers::build_nearest(sampler, requested, Some(f.dim()), &[])?;
-                let realization = |r: usize| -> Result<_, VarianceError> {
-                    Ok(s.sample(&mut set_rng(e.seed, r as u64))?)
-                };
+    // Realizations are drawn once per (sampler, N) and shared by every
+    // integrand (optimized samplers cost a descent per set).
+    let mut cells_by_key = std::collections::BTreeMap::new();
+    for (si, sampler) in e.samplers.iter().enumerate() {
+        for (ni, &requested) in e.n.iter().enumerate() {
+            let dim = functions[0].dim();
+            if functions.iter().any(|f| f.dim() != dim) {
+                bail!(
+                    "{}: all integrands of an experiment must have the same dimension",
+                    a.file.display()
+                );
+            }
+            let (s, n) = samplers::build_nearest(sampler, requested, Some(dim), &[])?;
+            let sets = samplers::generate_sets(s.as_ref(), e.seed, e.sets, &|| {})?;
+            for (fi, f) in functions.iter().enumerate() {
+                let realization = |r: usize| -> Result<_, VarianceError> { Ok(sets[r].clone()) };
                 let (variance, stderr, method) = match spatial(f.as_ref(), e.sets, realization) {
                     Ok(p) => (p.variance, p.stderr, "spatial"),
                     Err(VarianceError::NoAutocovariance { .. }) => {
@@ -101,7 +108,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     }
                     Err(err) => return Err(err.into()),
                 };
-                cells.push(Cell {
+                let cell = Cell {
                     sampler: sampler.clone(),
                     integrand: f.spec(),
                     requested,
@@ -109,11 +116,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     variance,
                     stderr,
                     method,
-                });
+                };
+                cells_by_key.insert((si, fi, ni), cell);
                 bar.inc(1);
             }
         }
     }
+    let cells: Vec<Cell> = cells_by_key.into_values().collect();
     bar.finish_and_clear();
     write_atomic(&out.join("variances.csv"), |w| {
         writeln!(w, "sampler,integrand,n,variance,stderr,method,sets")?;

@@ -10,6 +10,7 @@ mod halton;
 mod jitter;
 mod multijitter;
 mod nrooks;
+mod optimized;
 mod poisson_disk;
 mod random;
 mod registry;

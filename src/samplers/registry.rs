@@ -3,7 +3,7 @@
 //! (`varspec sample --list`) and [`build`] read.
 
 use super::{Sampler, SamplerError};
-use super::{halton, jitter, multijitter, nrooks, poisson_disk, random, sobol, umj};
+use super::{halton, jitter, multijitter, nrooks, optimized, poisson_disk, random, sobol, umj};
 
 /// The dimensions a sampler supports and the one it uses by default.
 #[derive(Debug, Clone, Copy)]
@@ -204,6 +204,30 @@ pub const SAMPLERS: &[SamplerInfo] = &[
         count: "any N",
         params: &[],
         build: halton::from_config,
+    },
+    SamplerInfo {
+        name: "blue-noise",
+        aliases: &["optimized"],
+        summary: "spectral descent from random points toward a target (default: disk family, CCVT-like blue noise)",
+        dims: DimRange {
+            min: 1,
+            max: 4,
+            default: 2,
+        },
+        count: "any N",
+        params: &[
+            ParamInfo {
+                key: "target",
+                default: "family:disks",
+                help: "family:disks, power:A, radial:FILE.csv or an integrand spec (see varspec optimize points)",
+            },
+            ParamInfo {
+                key: "iters",
+                default: "1000",
+                help: "maximum descent iterations per set",
+            },
+        ],
+        build: optimized::from_config,
     },
 ];
 
