@@ -15,6 +15,7 @@ mod progress;
 mod sample;
 mod source;
 mod spectrum;
+mod tables;
 
 use std::process::ExitCode;
 
@@ -50,6 +51,8 @@ enum Command {
     /// Optimizers: point positions toward a target spectrum.
     #[command(subcommand)]
     Optimize(optimize::OptimizeCommand),
+    /// Pattern tables for renderers: csv, json, raw f32/f64, C header, with metadata.
+    Tables(tables::Args),
     /// The reference integrands and their parameters.
     Integrands(integrands::Args),
     /// Benchmarks that print speed against error.
@@ -74,6 +77,7 @@ pub fn main() -> ExitCode {
         Command::Converge(a) => converge::run(a),
         Command::Experiment(a) => experiment::run(a),
         Command::Optimize(c) => optimize::run(c),
+        Command::Tables(a) => tables::run(a),
         Command::Integrands(a) => integrands::run(a),
     };
     match result {

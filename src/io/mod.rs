@@ -2,6 +2,7 @@
 
 pub mod atomic;
 pub mod pointfile;
+pub mod tables;
 
 pub use atomic::write_atomic;
 pub use pointfile::{PointFileError, PointFormat, read_point_sets, write_point_sets};

@@ -1,0 +1,144 @@
+//! `varspec tables`: pattern tables for renderers, with metadata.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use clap::ValueEnum;
+
+use super::{args, progress};
+use varspec::integrands;
+use varspec::io::read_point_sets;
+use varspec::io::tables::{TableFormat, TableMetadata, write_table};
+use varspec::io::write_atomic;
+use varspec::samplers;
+use varspec::variance::spatial_variance;
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FormatArg {
+    Csv,
+    Json,
+    F32,
+    F64,
+    CHeader,
+}
+
+/// Reference integrands whose predicted variance goes into the metadata.
+const REFERENCE: [&str; 4] = [
+    "disk:r=0.3",
+    "box:w=0.5,h=0.25,angle=30",
+    "gaussian:sx=0.1,sy=0.05,angle=20",
+    "halfplane:angle=17,offset=0.07",
+];
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Sampler to draw the table from.
+    #[arg(long, conflicts_with = "from", required_unless_present = "from")]
+    sampler: Option<String>,
+    /// Point-set file to convert instead.
+    #[arg(long)]
+    from: Option<PathBuf>,
+    /// Points per set (with --sampler).
+    #[arg(short = 'n')]
+    n: Option<usize>,
+    /// Dimension (with --sampler).
+    #[arg(short = 'd', long = "dim")]
+    dim: Option<usize>,
+    /// Sets (with --sampler).
+    #[arg(long, default_value_t = 16)]
+    sets: usize,
+    /// Seed (with --sampler).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Sampler parameter key=value (repeatable).
+    #[arg(long = "param", value_parser = args::key_value)]
+    params: Vec<(String, String)>,
+    /// Output format.
+    #[arg(long, value_enum)]
+    format: FormatArg,
+    /// Output file (csv, f32 and f64 also get PATH.json with the metadata).
+    #[arg(short = 'o', long = "output")]
+    output: PathBuf,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let (sets, source) = match (&a.sampler, &a.from) {
+        (Some(name), _) => {
+            let n = a.n.context("--sampler needs -n")?;
+            if a.sets == 0 {
+                bail!("--sets must be at least 1");
+            }
+            let s = samplers::build(name, n, a.dim, &a.params)?;
+            let bar = progress::bar(a.sets as u64, "sampling");
+            let sets = samplers::generate_sets(s.as_ref(), a.seed, a.sets, &|| bar.inc(1))?;
+            bar.finish_and_clear();
+            (sets, name.clone())
+        }
+        (None, Some(path)) => (read_point_sets(path)?, path.display().to_string()),
+        (None, None) => bail!("give --sampler or --from"),
+    };
+    let (n, dim) = (sets[0].len(), sets[0].dim());
+    if sets.iter().any(|s| s.len() != n) {
+        bail!("{source}: a table needs every set to have the same N");
+    }
+    let predicted_variance = if dim == 2 {
+        REFERENCE
+            .iter()
+            .map(|spec| -> anyhow::Result<(String, f64)> {
+                let f = integrands::parse(spec)?;
+                let mut total = 0.0;
+                for s in &sets {
+                    total += spatial_variance(s, f.as_ref())?.0;
+                }
+                Ok((f.spec(), total / sets.len() as f64))
+            })
+            .collect::<anyhow::Result<_>>()?
+    } else {
+        Vec::new()
+    };
+    let format = match a.format {
+        FormatArg::Csv => TableFormat::Csv,
+        FormatArg::Json => TableFormat::Json,
+        FormatArg::F32 => TableFormat::F32,
+        FormatArg::F64 => TableFormat::F64,
+        FormatArg::CHeader => TableFormat::CHeader,
+    };
+    let value_type = match format {
+        TableFormat::F32 | TableFormat::CHeader => "f32 (float), little-endian where raw",
+        _ => "f64",
+    };
+    let meta = TableMetadata {
+        generator: format!("varspec {}", env!("CARGO_PKG_VERSION")),
+        source,
+        params: a.params.clone(),
+        seed: a.seed,
+        n,
+        dim,
+        sets: sets.len(),
+        layout: format!("[set][point][dimension], {value_type}, values in [0, 1)"),
+        predicted_variance,
+    };
+    let name = a
+        .output
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "table".into());
+    write_atomic(&a.output, |w| write_table(w, &sets, &meta, format, &name))?;
+    if format.needs_sidecar() {
+        let mut sidecar = a.output.clone().into_os_string();
+        sidecar.push(".json");
+        write_atomic(std::path::Path::new(&sidecar), |w| {
+            w.write_all(
+                serde_json::to_string_pretty(&meta)
+                    .map_err(std::io::Error::other)?
+                    .as_bytes(),
+            )
+        })?;
+    }
+    println!(
+        "wrote {} ({} sets of {n} points in {dim}D)",
+        a.output.display(),
+        sets.len()
+    );
+    Ok(())
+}

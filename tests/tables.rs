@@ -1,0 +1,195 @@
+//! Pattern tables: every format reads back to the values written (f32 to
+//! the f32 rounding, kept below 1), metadata is present, and the C header
+//! compiles.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use varspec::PointSet;
+use varspec::io::tables::{
+    F32_PREV_ONE, TableFormat, TableMetadata, read_raw, to_unit_f32, write_table,
+};
+use varspec::rng::PREV_ONE;
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("varspec-tables-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn varspec(args: &[&str]) {
+    let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+fn sidecar(path: &Path) -> TableMetadata {
+    let mut p = path.as_os_str().to_owned();
+    p.push(".json");
+    serde_json::from_str(&std::fs::read_to_string(PathBuf::from(p)).unwrap()).unwrap()
+}
+
+#[test]
+fn every_format_round_trips() {
+    let d = dir();
+    let reference = d.join("ref.csv");
+    varspec(&[
+        "sample",
+        "sobol",
+        "-n",
+        "32",
+        "--sets",
+        "3",
+        "--seed",
+        "4",
+        "-o",
+        reference.to_str().unwrap(),
+    ]);
+    let sets = varspec::io::read_point_sets(&reference).unwrap();
+    let values: Vec<f64> = sets.iter().flat_map(|s| s.coords().to_vec()).collect();
+    let out = |ext: &str| d.join(format!("table.{ext}"));
+    for (format, ext) in [
+        ("csv", "csv"),
+        ("json", "json"),
+        ("f32", "f32"),
+        ("f64", "f64"),
+        ("c-header", "h"),
+    ] {
+        varspec(&[
+            "tables",
+            "--from",
+            reference.to_str().unwrap(),
+            "--format",
+            format,
+            "-o",
+            out(ext).to_str().unwrap(),
+        ]);
+    }
+    // CSV and f64: identical bits.
+    let csv: Vec<f64> = varspec::io::read_point_sets(&out("csv"))
+        .unwrap()
+        .iter()
+        .flat_map(|s| s.coords().to_vec())
+        .collect();
+    assert_eq!(csv, values);
+    let f64s: Vec<f64> = read_raw(
+        &std::fs::read(out("f64")).unwrap(),
+        TableFormat::F64,
+        3,
+        32,
+        2,
+    )
+    .unwrap()
+    .concat();
+    assert_eq!(f64s, values);
+    // f32: the nearest f32, below 1.
+    let f32s: Vec<f64> = read_raw(
+        &std::fs::read(out("f32")).unwrap(),
+        TableFormat::F32,
+        3,
+        32,
+        2,
+    )
+    .unwrap()
+    .concat();
+    for (a, b) in f32s.iter().zip(&values) {
+        assert_eq!(*a, to_unit_f32(*b) as f64);
+        assert!((0.0..1.0).contains(a));
+    }
+    // JSON: metadata and exact values.
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out("json")).unwrap()).unwrap();
+    let json: Vec<f64> = doc["sets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| {
+            s.as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|p| p.as_array().unwrap().iter().map(|v| v.as_f64().unwrap()))
+        })
+        .collect();
+    assert_eq!(json, values);
+    assert_eq!(doc["metadata"]["n"].as_u64(), Some(32));
+    assert_eq!(
+        doc["metadata"]["predicted_variance"]
+            .as_array()
+            .unwrap()
+            .len(),
+        4
+    );
+    // Sidecars of the formats without inline metadata.
+    for ext in ["csv", "f32", "f64"] {
+        let m = sidecar(&out(ext));
+        assert_eq!((m.n, m.dim, m.sets), (32, 2, 3));
+        assert!(m.generator.starts_with("varspec "));
+    }
+    // C header: the literals parse back to the f32 values, and it compiles.
+    let header = std::fs::read_to_string(out("h")).unwrap();
+    let body = &header[header.find("= {").unwrap()..];
+    let parsed: Vec<f32> = body
+        .split(|c: char| {
+            c == ',' || c == '{' || c == '}' || c.is_whitespace() || c == '=' || c == ';'
+        })
+        .filter(|t| t.ends_with('f') && t.starts_with(|c: char| c.is_ascii_digit()))
+        .map(|t| t.trim_end_matches('f').parse().unwrap())
+        .collect();
+    assert_eq!(parsed.len(), values.len());
+    for (a, b) in parsed.iter().zip(&values) {
+        assert_eq!(*a, to_unit_f32(*b));
+    }
+    let c = d.join("use.c");
+    std::fs::write(&c, "#include \"table.h\"\nfloat first(void) { return table[VARSPEC_TABLE_SETS - 1][VARSPEC_TABLE_N - 1][VARSPEC_TABLE_DIM - 1]; }\n").unwrap();
+    let cc = Command::new("cc")
+        .args([
+            "-c",
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            c.to_str().unwrap(),
+            "-o",
+            d.join("use.o").to_str().unwrap(),
+        ])
+        .output()
+        .expect("a C compiler `cc` (the project's machines have gcc)");
+    assert!(
+        cc.status.success(),
+        "cc -c failed: {}",
+        String::from_utf8_lossy(&cc.stderr)
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn f32_tables_stay_below_one() {
+    // 1 − 2⁻⁵³ rounds to 1.0f32; the table must hold the largest f32 below 1.
+    let set = PointSet::new(2, vec![PREV_ONE, 0.0, 0.999_999_99, 0.5]).unwrap();
+    let meta = TableMetadata {
+        generator: "test".into(),
+        source: "test".into(),
+        params: vec![],
+        seed: 0,
+        n: 2,
+        dim: 2,
+        sets: 1,
+        layout: String::new(),
+        predicted_variance: vec![],
+    };
+    let mut bytes = Vec::new();
+    write_table(&mut bytes, &[set], &meta, TableFormat::F32, "t").unwrap();
+    let values = read_raw(&bytes, TableFormat::F32, 1, 2, 2)
+        .unwrap()
+        .concat();
+    assert_eq!(values[0], F32_PREV_ONE as f64);
+    assert_eq!(values[2], F32_PREV_ONE as f64);
+    assert!(values.iter().all(|v| (0.0..1.0).contains(v)));
+    assert!(read_raw(&bytes[1..], TableFormat::F32, 1, 2, 2).is_err());
+}
