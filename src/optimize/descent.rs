@@ -44,14 +44,16 @@ pub struct DescentOptions {
 impl DescentOptions {
     /// Defaults for N points in d dimensions and `target`. The box must hold
     /// the spectrum the target weighs: blue-noise families need a few times
-    /// the Nyquist radius N^(1/d), K = max(16, ⌈2.5·N^(1/d)⌉); an integrand's
+    /// the Nyquist radius N^(1/d), K = max(16, ⌈2.5·N^(1/d)⌉) but at most 400
+    /// (1.56·√N at N = 65,536: still past the peak at ≈ 1.07·√N, and a
+    /// fourth of the FFT work of 2.5·√N); an integrand's
     /// P_f reaches further (what lies beyond the box is variance the descent
     /// cannot see), K = clamp(⌈8·N^(1/d)⌉, 32, 128).
     pub fn for_target(n: usize, dim: usize, target: &Target) -> Self {
         let root = (n as f64).powf(1.0 / dim as f64);
         let half = match target {
             Target::Integrand(_) => ((8.0 * root).ceil() as usize).clamp(32, 128),
-            _ => ((2.5 * root).ceil() as usize).max(16),
+            _ => ((2.5 * root).ceil() as usize).clamp(16, 400),
         };
         DescentOptions {
             half,
