@@ -222,7 +222,7 @@ mod tests {
         }
         assert!(disk_family_power(1.0) > disk_family_power(5.0));
         // Four times finer panels change nothing at 1e-9.
-        for k in [3.0, 47.0, 301.0] {
+        for k in [3.0f64, 47.0, 301.0] {
             let fine = crate::quadrature::integrate_panels(
                 0.05,
                 0.45,
