@@ -11,7 +11,8 @@
 //! e_r(a,b) = Σ_(k∈Ω) F_f(k)·conj(S_r(k; a,b))/N, J(a,b) = mean_r |e_r|²,
 //! with S_r(k; a,b) = Σ_j e^(−2πi(kx(x_j + a u_j) + ky(y_j + b v_j) + ku u_j + kv v_j)).
 //! The mod-1 wrap of x' does not change e^(−2πi kx x') for integer kx, so J
-//! is smooth. A coarse scan of a (b = 0), then b, seeds Nelder–Mead (argmin).
+//! is smooth. A coarse scan of a (b = 0) refined by Brent's method, then the
+//! same for b, seeds Nelder–Mead (both from argmin).
 //! For `defocus` with shear c the analytic optimum is a = b = −c: then
 //! x' + c(u − ½) = x − c/2 and the (x, y) stratification integrates g
 //! directly.
@@ -164,8 +165,30 @@ pub struct ShearResult {
     pub evaluations: u64,
 }
 
-/// Scans a on [−range, range] (b = 0), then b (a fixed), in `steps`, and
-/// refines the best point with Nelder–Mead.
+/// J along one coordinate, the other held fixed, for Brent's method.
+struct Line<'a> {
+    objective: &'a ShearObjective,
+    fixed: f64,
+    along_a: bool,
+}
+
+impl CostFunction for Line<'_> {
+    type Param = f64;
+    type Output = f64;
+
+    fn cost(&self, t: &f64) -> Result<f64, ArgminError> {
+        Ok(if self.along_a {
+            self.objective.value(*t, self.fixed)
+        } else {
+            self.objective.value(self.fixed, *t)
+        })
+    }
+}
+
+/// Scans a on [−range, range] (b = 0) in `steps`, refines it by Brent's
+/// method within one step of the best grid point, does the same for b (a
+/// fixed) — the exact search when the objective separates in a and b — and
+/// polishes (a, b) jointly with Nelder–Mead.
 ///
 /// # Errors
 /// [`OptimizeError::Search`] if argmin fails.
@@ -177,17 +200,40 @@ pub fn search_shear(
     let grid: Vec<f64> = (0..=steps)
         .map(|i| -range + 2.0 * range * i as f64 / steps as f64)
         .collect();
-    let best_of = |f: &dyn Fn(f64) -> f64| {
-        grid.iter()
-            .map(|&t| (t, f(t)))
-            .min_by(|x, y| x.1.total_cmp(&y.1))
-            .expect("grid is not empty")
-    };
-    let (a0, _) = best_of(&|a| objective.value(a, 0.0));
-    let (b0, _) = best_of(&|b| objective.value(a0, b));
-    let unsheared = objective.value(0.0, 0.0);
     let d = 2.0 * range / steps as f64;
-    let simplex = vec![vec![a0, b0], vec![a0 + d, b0], vec![a0, b0 + d]];
+    let line_minimum = |fixed: f64, along_a: bool| -> Result<f64, OptimizeError> {
+        let at = |t: f64| {
+            if along_a {
+                objective.value(t, fixed)
+            } else {
+                objective.value(fixed, t)
+            }
+        };
+        let (t0, _) = grid
+            .iter()
+            .map(|&t| (t, at(t)))
+            .min_by(|x, y| x.1.total_cmp(&y.1))
+            .expect("grid is not empty");
+        let line = Line {
+            objective: &objective,
+            fixed,
+            along_a,
+        };
+        let brent = argmin::solver::brent::BrentOpt::new(t0 - d, t0 + d).set_tolerance(1e-6, 1e-9);
+        let result = Executor::new(line, brent)
+            .configure(|s| s.max_iters(60))
+            .run()
+            .map_err(|e| OptimizeError::Search(e.to_string()))?;
+        Ok(result.state().get_best_param().copied().unwrap_or(t0))
+    };
+    let a0 = line_minimum(0.0, true)?;
+    let b0 = line_minimum(a0, false)?;
+    let unsheared = objective.value(0.0, 0.0);
+    let simplex = vec![
+        vec![a0, b0],
+        vec![a0 + 0.25 * d, b0],
+        vec![a0, b0 + 0.25 * d],
+    ];
     let solver = NelderMead::new(simplex)
         .with_sd_tolerance(1e-12)
         .map_err(|e| OptimizeError::Search(e.to_string()))?;
