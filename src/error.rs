@@ -18,11 +18,12 @@ pub enum Error {
     #[error(transparent)]
     Sampler(#[from] SamplerError),
     /// An output file could not be written.
-    #[error("cannot write {path}: {source}")]
+    #[error("cannot write {path}: {cause}")]
     Write {
         /// The file that was being written.
         path: std::path::PathBuf,
-        /// The underlying I/O error.
-        source: std::io::Error,
+        /// The underlying I/O error (in the message, so not repeated as a
+        /// source when error chains are printed).
+        cause: std::io::Error,
     },
 }

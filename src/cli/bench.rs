@@ -43,7 +43,22 @@ pub struct SpectrumArgs {
     quick: bool,
 }
 
+/// Creates the folder of a benchmark's CSV before the (long) run, so a bad
+/// path fails at once rather than after the measurements.
+fn prepare(csv: &std::path::Path) -> anyhow::Result<()> {
+    if let Some(dir) = csv.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+    }
+    Ok(())
+}
+
 pub fn run(c: BenchCommand) -> anyhow::Result<()> {
+    let csv = match &c {
+        BenchCommand::Spectrum(a) => &a.csv,
+        BenchCommand::Predict(a) => &a.csv,
+    };
+    prepare(csv)?;
     match c {
         BenchCommand::Spectrum(a) => spectrum(a),
         BenchCommand::Predict(a) => predict(a),

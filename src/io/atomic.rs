@@ -20,9 +20,9 @@ pub fn write_atomic<F>(path: &Path, write: F) -> Result<(), Error>
 where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
-    let fail = |source| Error::Write {
+    let fail = |cause| Error::Write {
         path: path.to_path_buf(),
-        source,
+        cause,
     };
     let tmp = temporary_sibling(path);
     let result = (|| {

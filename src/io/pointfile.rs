@@ -22,12 +22,12 @@ use crate::points::PointSet;
 #[derive(Debug, thiserror::Error)]
 pub enum PointFileError {
     /// The file could not be opened or read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {cause}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// The I/O error.
-        source: io::Error,
+        /// The I/O error (in the message, not repeated as a source).
+        cause: io::Error,
     },
     /// No points at all.
     #[error("{path}: the file holds no points")]
@@ -167,9 +167,9 @@ pub enum PointFormat {
 /// # Errors
 /// [`PointFileError`] naming the file and, for malformed content, the line.
 pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
-    let file = File::open(path).map_err(|source| PointFileError::Io {
+    let file = File::open(path).map_err(|cause| PointFileError::Io {
         path: path.into(),
-        source,
+        cause,
     })?;
     parse_point_sets(BufReader::new(file), path)
 }
@@ -208,9 +208,9 @@ pub fn parse_point_sets<R: BufRead>(
         format: None,
     };
     for (idx, line) in reader.lines().enumerate() {
-        let line = line.map_err(|source| PointFileError::Io {
+        let line = line.map_err(|cause| PointFileError::Io {
             path: path.into(),
-            source,
+            cause,
         })?;
         parser
             .line(line.trim_end_matches('\r'))

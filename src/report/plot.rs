@@ -75,9 +75,9 @@ pub fn line_plot_png(plot: &LinePlot, path: &Path) -> Result<(), Error> {
     let (w, h) = (800u32, 560u32);
     let mut buf = vec![255u8; (w * h * 3) as usize];
     let drawn = draw_lines(plot, &mut buf, (w, h));
-    drawn.map_err(|source| Error::Write {
+    drawn.map_err(|cause| Error::Write {
         path: path.to_path_buf(),
-        source,
+        cause,
     })?;
     let img = image::RgbImage::from_raw(w, h, buf).expect("buffer matches size");
     save_png(&img, path)
@@ -215,9 +215,9 @@ fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
 /// [`Error::Write`] naming `path`; a spectrum that is not 2D is refused the
 /// same way.
 pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(), Error> {
-    let fail = |source| Error::Write {
+    let fail = |cause| Error::Write {
         path: path.to_path_buf(),
-        source,
+        cause,
     };
     if spectrum.freqs.dim != 2 {
         return Err(fail(std::io::Error::other(
