@@ -1,23 +1,8 @@
 //! The command line as scripts use it: determinism across thread counts,
 //! exit codes and messages on bad input, the sampler list, pictures.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn varspec(args: &[&str], threads: Option<&str>) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_varspec"));
-    cmd.args(args);
-    if let Some(t) = threads {
-        cmd.env("RAYON_NUM_THREADS", t);
-    }
-    cmd.output().expect("the varspec binary runs")
-}
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("varspec-cli-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+mod common;
+use common::{temp_dir, varspec, varspec_with};
 
 #[test]
 fn same_seed_gives_identical_bytes_on_one_and_two_threads() {
@@ -34,8 +19,8 @@ fn same_seed_gives_identical_bytes_on_one_and_two_threads() {
     ] {
         let mut args = vec!["sample", sampler, "-n", n, "--sets", "16", "--seed", "42"];
         args.extend(extra);
-        let one = varspec(&args, Some("1"));
-        let two = varspec(&args, Some("2"));
+        let one = varspec_with(&args, Some("1"));
+        let two = varspec_with(&args, Some("2"));
         assert!(
             one.status.success(),
             "{sampler}: {}",
@@ -49,7 +34,7 @@ fn same_seed_gives_identical_bytes_on_one_and_two_threads() {
             one.stderr.is_empty(),
             "{sampler}: no progress bar off a terminal"
         );
-        let other_seed = varspec(
+        let other_seed = varspec_with(
             &["sample", sampler, "-n", n, "--sets", "16", "--seed", "43"],
             Some("2"),
         );
@@ -61,25 +46,22 @@ fn same_seed_gives_identical_bytes_on_one_and_two_threads() {
 fn output_file_matches_stdout_and_reads_back() {
     let dir = temp_dir("out");
     let path = dir.join("j.csv");
-    let file_run = varspec(
-        &[
-            "sample",
-            "jitter",
-            "-n",
-            "16",
-            "--sets",
-            "3",
-            "-o",
-            path.to_str().unwrap(),
-        ],
-        None,
-    );
+    let file_run = varspec(&[
+        "sample",
+        "jitter",
+        "-n",
+        "16",
+        "--sets",
+        "3",
+        "-o",
+        path.to_str().unwrap(),
+    ]);
     assert!(file_run.status.success());
-    let stdout_run = varspec(&["sample", "jitter", "-n", "16", "--sets", "3"], None);
+    let stdout_run = varspec(&["sample", "jitter", "-n", "16", "--sets", "3"]);
     assert_eq!(std::fs::read(&path).unwrap(), stdout_run.stdout);
     let sets = varspec::io::read_point_sets(&path).unwrap();
     assert_eq!((sets.len(), sets[0].len(), sets[0].dim()), (3, 16, 2));
-    let utk = varspec(&["sample", "sobol", "-n", "8", "--format", "utk"], None);
+    let utk = varspec(&["sample", "sobol", "-n", "8", "--format", "utk"]);
     let text = String::from_utf8(utk.stdout).unwrap();
     assert_eq!(text.lines().count(), 8);
     assert!(text.lines().all(|l| l.split(' ').count() == 2));
@@ -135,20 +117,13 @@ fn bad_requests_fail_with_a_specific_message() {
             "/nonexistent-dir/x.csv",
         ),
     ] {
-        let out = varspec(&args, None);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} should fail");
-        assert!(
-            err.contains(phrase),
-            "{args:?}: {err:?} should contain {phrase:?}"
-        );
-        assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+        common::assert_fails(&args, phrase);
     }
 }
 
 #[test]
 fn list_names_every_sampler_with_constraints() {
-    let out = varspec(&["sample", "--list"], None);
+    let out = varspec(&["sample", "--list"]);
     let text = String::from_utf8(out.stdout).unwrap();
     for info in varspec::samplers::SAMPLERS {
         assert!(
@@ -168,25 +143,19 @@ fn plot_draws_a_projection_and_reports_bad_files_by_line() {
     let points = dir.join("umj.csv");
     let png = dir.join("xu.png");
     assert!(
-        varspec(
-            &["sample", "umj", "-n", "64", "-o", points.to_str().unwrap()],
-            None
-        )
-        .status
-        .success()
+        varspec(&["sample", "umj", "-n", "64", "-o", points.to_str().unwrap()])
+            .status
+            .success()
     );
-    let out = varspec(
-        &[
-            "plot",
-            "points",
-            points.to_str().unwrap(),
-            "--dims",
-            "0,2",
-            "-o",
-            png.to_str().unwrap(),
-        ],
-        None,
-    );
+    let out = varspec(&[
+        "plot",
+        "points",
+        points.to_str().unwrap(),
+        "--dims",
+        "0,2",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
     assert!(
         out.status.success(),
         "{}",
@@ -194,31 +163,25 @@ fn plot_draws_a_projection_and_reports_bad_files_by_line() {
     );
     let img = image::open(&png).unwrap();
     assert_eq!((img.width(), img.height()), (512, 512));
-    let bad_dims = varspec(
-        &[
-            "plot",
-            "points",
-            points.to_str().unwrap(),
-            "--dims",
-            "0,4",
-            "-o",
-            png.to_str().unwrap(),
-        ],
-        None,
-    );
+    let bad_dims = varspec(&[
+        "plot",
+        "points",
+        points.to_str().unwrap(),
+        "--dims",
+        "0,4",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
     assert!(String::from_utf8_lossy(&bad_dims.stderr).contains("out of range"));
     let broken = dir.join("broken.csv");
     std::fs::write(&broken, "x0,x1\n0.5,0.5\n0.5,1.5\n").unwrap();
-    let out = varspec(
-        &[
-            "plot",
-            "points",
-            broken.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-        ],
-        None,
-    );
+    let out = varspec(&[
+        "plot",
+        "points",
+        broken.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         !out.status.success() && err.contains("broken.csv:3:") && err.contains("1.5"),
@@ -230,18 +193,15 @@ fn plot_draws_a_projection_and_reports_bad_files_by_line() {
 #[test]
 fn compare_writes_a_table_and_pictures() {
     let dir = temp_dir("compare");
-    let out = varspec(
-        &[
-            "compare",
-            "-n",
-            "100",
-            "--sets",
-            "2",
-            "-o",
-            dir.to_str().unwrap(),
-        ],
-        None,
-    );
+    let out = varspec(&[
+        "compare",
+        "-n",
+        "100",
+        "--sets",
+        "2",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
     assert!(
         out.status.success(),
         "{}",

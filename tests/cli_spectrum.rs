@@ -1,20 +1,10 @@
 //! `varspec spectrum` and `varspec pcf` as scripts use them.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
-fn varspec(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_varspec"))
-        .args(args)
-        .output()
-        .expect("the varspec binary runs")
-}
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("varspec-clispec-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+mod common;
+use common::{temp_dir, varspec, varspec_with};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
@@ -186,39 +176,26 @@ fn bad_spectrum_requests_are_clear_errors() {
             "nearest valid N: 9 or 16",
         ),
     ] {
-        let out = varspec(&args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} should fail");
-        assert!(
-            err.contains(phrase),
-            "{args:?}: {err:?} should contain {phrase:?}"
-        );
-        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        common::assert_fails(&args, phrase);
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
 fn spectrum_output_does_not_depend_on_thread_count() {
-    let run = |threads: &str| {
-        Command::new(env!("CARGO_BIN_EXE_varspec"))
-            .args([
-                "spectrum",
-                "--sampler",
-                "cmj",
-                "-n",
-                "100",
-                "--sets",
-                "50",
-                "--res",
-                "32",
-                "--seed",
-                "9",
-            ])
-            .env("RAYON_NUM_THREADS", threads)
-            .output()
-            .unwrap()
-            .stdout
-    };
+    let args = [
+        "spectrum",
+        "--sampler",
+        "cmj",
+        "-n",
+        "100",
+        "--sets",
+        "50",
+        "--res",
+        "32",
+        "--seed",
+        "9",
+    ];
+    let run = |threads| varspec_with(&args, Some(threads)).stdout;
     assert_eq!(run("1"), run("2"));
 }

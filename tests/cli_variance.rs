@@ -1,14 +1,8 @@
 //! `varspec predict`, `converge`, `integrands` and `experiment` as scripts
 //! use them: the JSON keys of DESIGN.md §2, errors, determinism.
 
-use std::process::{Command, Output};
-
-fn varspec(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_varspec"))
-        .args(args)
-        .output()
-        .expect("the varspec binary runs")
-}
+mod common;
+use common::{varspec, varspec_with};
 
 fn json(args: &[&str]) -> serde_json::Value {
     let out = varspec(args);
@@ -104,22 +98,21 @@ fn predict_json_has_the_contract_keys_and_the_methods_agree() {
 #[test]
 fn predict_output_does_not_depend_on_thread_count() {
     let run = |threads: &str| {
-        let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
-            .args([
-                "predict",
-                "--sampler",
-                "cmj",
-                "-n",
-                "100",
-                "--integrand",
-                "box:w=0.3,h=0.6,angle=10",
-                "--sets",
-                "20",
-            ])
-            .args(["--realizations", "3000", "--json"])
-            .env("RAYON_NUM_THREADS", threads)
-            .output()
-            .unwrap();
+        let args = [
+            "predict",
+            "--sampler",
+            "cmj",
+            "-n",
+            "100",
+            "--integrand",
+            "box:w=0.3,h=0.6,angle=10",
+        ];
+        let args = [
+            &args[..],
+            &["--sets", "20", "--realizations", "3000", "--json"],
+        ]
+        .concat();
+        let out = varspec_with(&args, Some(threads));
         let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         for k in ["fourier", "spatial", "empirical"] {
             v[k].as_object_mut().unwrap().remove("seconds");
@@ -237,14 +230,7 @@ fn bad_requests_fail_clearly() {
             "/nonexistent/exp.json",
         ),
     ] {
-        let out = varspec(&args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success(), "{args:?} should fail");
-        assert!(
-            err.contains(phrase),
-            "{args:?}: {err:?} should contain {phrase:?}"
-        );
-        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        common::assert_fails(&args, phrase);
     }
 }
 

@@ -27,3 +27,18 @@ pub fn dims(text: &str, count: usize) -> anyhow::Result<Vec<usize>> {
     }
     Ok(dims)
 }
+
+/// How realizations of a sampler are drawn: how many, from which seed, with
+/// which sampler parameters (shared by the commands that draw sets).
+#[derive(clap::Args)]
+pub struct DrawArgs {
+    /// Realizations to draw (with a sampler).
+    #[arg(long, default_value_t = 16)]
+    pub sets: usize,
+    /// Seed: the same seed gives bit-identical realizations for any thread count.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Sampler parameter key=value (repeatable; see `varspec sample --list`).
+    #[arg(long = "param", value_parser = key_value)]
+    pub params: Vec<(String, String)>,
+}

@@ -7,7 +7,7 @@ use anyhow::bail;
 use clap::ValueEnum;
 use serde_json::json;
 
-use super::args;
+use super::args::DrawArgs;
 use super::progress;
 use varspec::integrands;
 use varspec::io::write_atomic;
@@ -35,15 +35,8 @@ pub struct Args {
     /// Comma-separated N values (constrained samplers use the nearest valid N).
     #[arg(long = "n", value_delimiter = ',', required = true)]
     ns: Vec<usize>,
-    /// Realizations averaged per N.
-    #[arg(long, default_value_t = 16)]
-    sets: usize,
-    /// Seed.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// Sampler parameter key=value (repeatable).
-    #[arg(long = "param", value_parser = args::key_value)]
-    params: Vec<(String, String)>,
+    #[command(flatten)]
+    draw: DrawArgs,
     /// Predictor (default: spatial, or fourier for integrands without c_f).
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
@@ -82,13 +75,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut points = Vec::new();
     for &requested in &a.ns {
         let (sampler, n) =
-            samplers::build_nearest(&a.sampler, requested, Some(f.dim()), &a.params)?;
+            samplers::build_nearest(&a.sampler, requested, Some(f.dim()), &a.draw.params)?;
         let realization = |r: usize| -> Result<_, VarianceError> {
-            Ok(sampler.sample(&mut set_rng(a.seed, r as u64))?)
+            Ok(sampler.sample(&mut set_rng(a.draw.seed, r as u64))?)
         };
         let (variance, stderr) = match method {
             MethodArg::Spatial => {
-                let e = spatial(f.as_ref(), a.sets, realization)?;
+                let e = spatial(f.as_ref(), a.draw.sets, realization)?;
                 (e.variance, e.stderr)
             }
             MethodArg::Fourier => {
@@ -96,7 +89,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     f.as_ref(),
                     a.res.saturating_sub(1) / 2,
                     1e-10,
-                    a.sets,
+                    a.draw.sets,
                     realization,
                 )?;
                 (e.variance, e.truncation_bound)
@@ -167,7 +160,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let out = json!({
             "sampler": a.sampler, "integrand": f.spec(),
             "method": if method == MethodArg::Spatial { "spatial" } else { "fourier" },
-            "sets": a.sets,
+            "sets": a.draw.sets,
             "points": points.iter().map(|p| json!({"n": p.n, "variance": p.variance, "stderr": p.stderr})).collect::<Vec<_>>(),
             "slope": fit.slope, "slope_ci": fit.slope_ci.map(|(l, h)| vec![l, h]),
             "theory": theory, "adjusted_n": adjusted,

@@ -8,6 +8,7 @@ use clap::ValueEnum;
 use serde_json::{Value, json};
 
 use super::source::SourceArgs;
+use varspec::PointSet;
 use varspec::integrands;
 use varspec::variance::{VarianceError, empirical, fourier, spatial};
 
@@ -60,8 +61,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let f = integrands::parse(&a.integrand)?;
     let source = a.source.resolve(Some(f.dim()))?;
     let sets = source.count();
-    let n = source.get(0)?.len();
+    let n = source.points_per_set();
     let wants = |m: MethodArg| a.method == m || a.method == MethodArg::All;
+    // The Fourier and spatial forms pass over the same realizations: draw
+    // them once (a sampler's draw can be costly, e.g. an optimized set).
+    let drawn = if wants(MethodArg::Fourier) || wants(MethodArg::Spatial) {
+        source.realizations()?
+    } else {
+        Vec::new()
+    };
+    let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(drawn[r].clone()) };
     let mut out = serde_json::Map::new();
     out.insert("integrand".into(), json!(f.spec()));
     out.insert("source".into(), json!(source.name()));
@@ -75,9 +84,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
         let half = res.saturating_sub(1) / 2;
         let start = Instant::now();
-        let e = fourier(f.as_ref(), half, a.tol, sets, |r| {
-            source.get(r).map_err(lift)
-        })?;
+        let e = fourier(f.as_ref(), half, a.tol, sets, lend)?;
         out.insert(
             "fourier".into(),
             json!({
@@ -89,7 +96,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if wants(MethodArg::Spatial) {
         let start = Instant::now();
-        let value = match spatial(f.as_ref(), sets, |r| source.get(r).map_err(lift)) {
+        let value = match spatial(f.as_ref(), sets, lend) {
             Ok(e) => json!({
                 "variance": e.variance, "stderr": e.stderr, "rounding_bound": e.rounding_bound,
                 "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),

@@ -28,15 +28,8 @@ pub struct SourceArgs {
     /// Sampler dimension (with --sampler; default: the sampler's own).
     #[arg(short = 'd', long = "dim")]
     dim: Option<usize>,
-    /// Realizations to draw and average (with --sampler).
-    #[arg(long, default_value_t = 16)]
-    sets: usize,
-    /// Seed (with --sampler).
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// Sampler parameter key=value (with --sampler; repeatable).
-    #[arg(long = "param", value_parser = args::key_value)]
-    params: Vec<(String, String)>,
+    #[command(flatten)]
+    draw: args::DrawArgs,
     /// Analyse the projection onto these dimensions, e.g. 0,2 (XU) or 1,3 (YV).
     #[arg(long)]
     dims: Option<String>,
@@ -79,28 +72,39 @@ impl SourceArgs {
                 name: path.display().to_string(),
             },
             (None, Some(name)) => {
-                if self.sets == 0 {
+                if self.draw.sets == 0 {
                     bail!("--sets must be at least 1");
                 }
                 let n = self.n.context("--sampler needs -n")?;
-                let sampler = samplers::build(name, n, self.dim, &self.params)?;
+                let sampler = samplers::build(name, n, self.dim, &self.draw.params)?;
                 Source::Sampler {
                     sampler,
-                    seed: self.seed,
-                    sets: self.sets,
+                    seed: self.draw.seed,
+                    sets: self.draw.sets,
                     dims: dims.clone(),
                     name: format!("{name} N={n}"),
                 }
             }
             (None, None) => bail!("give a point-set file or --sampler"),
         };
-        let first = source.get(0)?;
-        if let Some(dim) = dim.filter(|&d| d != first.dim()) {
+        // Check the projection against the points' dimension without drawing
+        // a realization (an optimized sampler's draw is a whole descent).
+        let own = match &source {
+            Source::File { sets, .. } => sets[0].dim(),
+            Source::Sampler { sampler, .. } => sampler.dim(),
+        };
+        let found = match &dims {
+            Some(d) => PointSet::new(own, Vec::new())?
+                .projected(d)
+                .with_context(|| source.name().to_string())?
+                .dim(),
+            None => own,
+        };
+        if let Some(dim) = dim.filter(|&d| d != found) {
             bail!(
-                "{}: points are {}-dimensional where {dim} dimensions are needed; choose a projection with --dims \
+                "{}: points are {found}-dimensional where {dim} dimensions are needed; choose a projection with --dims \
                  (0,2 is XU, 1,3 is YV)",
-                source.name(),
-                first.dim()
+                source.name()
             );
         }
         Ok(source)
@@ -108,6 +112,25 @@ impl SourceArgs {
 }
 
 impl Source {
+    /// Points per realization.
+    pub fn points_per_set(&self) -> usize {
+        match self {
+            Source::File { sets, .. } => sets[0].len(),
+            Source::Sampler { sampler, .. } => sampler.points_per_set(),
+        }
+    }
+
+    /// Every realization, projected: a file's sets, or the sampler's
+    /// `count()` draws made once (in parallel, each from its own stream) for
+    /// commands that pass over them several times.
+    pub fn realizations(&self) -> anyhow::Result<Vec<PointSet>> {
+        use rayon::prelude::*;
+        (0..self.count())
+            .into_par_iter()
+            .map(|r| self.get(r))
+            .collect()
+    }
+
     /// Number of realizations.
     pub fn count(&self) -> usize {
         match self {

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::ValueEnum;
 
-use super::{args, progress};
+use super::args::DrawArgs;
+use super::progress;
 use varspec::integrands;
 use varspec::io::read_point_sets;
 use varspec::io::tables::{TableFormat, TableMetadata, write_table};
@@ -44,15 +45,8 @@ pub struct Args {
     /// Dimension (with --sampler).
     #[arg(short = 'd', long = "dim")]
     dim: Option<usize>,
-    /// Sets (with --sampler).
-    #[arg(long, default_value_t = 16)]
-    sets: usize,
-    /// Seed (with --sampler).
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    /// Sampler parameter key=value (repeatable).
-    #[arg(long = "param", value_parser = args::key_value)]
-    params: Vec<(String, String)>,
+    #[command(flatten)]
+    draw: DrawArgs,
     /// Output format.
     #[arg(long, value_enum)]
     format: FormatArg,
@@ -65,12 +59,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (sets, source) = match (&a.sampler, &a.from) {
         (Some(name), _) => {
             let n = a.n.context("--sampler needs -n")?;
-            if a.sets == 0 {
+            if a.draw.sets == 0 {
                 bail!("--sets must be at least 1");
             }
-            let s = samplers::build(name, n, a.dim, &a.params)?;
-            let bar = progress::bar(a.sets as u64, "sampling");
-            let sets = samplers::generate_sets(s.as_ref(), a.seed, a.sets, &|| bar.inc(1))?;
+            let s = samplers::build(name, n, a.dim, &a.draw.params)?;
+            let bar = progress::bar(a.draw.sets as u64, "sampling");
+            let sets =
+                samplers::generate_sets(s.as_ref(), a.draw.seed, a.draw.sets, &|| bar.inc(1))?;
             bar.finish_and_clear();
             (sets, name.clone())
         }
@@ -110,8 +105,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let meta = TableMetadata {
         generator: format!("varspec {}", env!("CARGO_PKG_VERSION")),
         source,
-        params: a.params.clone(),
-        seed: a.seed,
+        params: a.draw.params.clone(),
+        seed: a.draw.seed,
         n,
         dim,
         sets: sets.len(),

@@ -7,7 +7,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::{Integrand, IntegrandClass};
+use super::{Integrand, IntegrandClass, nearest_image, sum_over_images};
 use crate::spectrum::phase::exp_neg_2pi_i;
 
 /// Periodized disk indicator.
@@ -36,12 +36,6 @@ impl Disk {
         }
         2.0 * r * r * (d / (2.0 * r)).acos() - 0.5 * d * ((2.0 * r - d) * (2.0 * r + d)).sqrt()
     }
-}
-
-/// x reduced to its nearest periodic image, in [−½, ½].
-#[inline]
-pub(crate) fn nearest_image(x: f64) -> f64 {
-    x - x.round()
 }
 
 impl Integrand for Disk {
@@ -77,19 +71,16 @@ impl Integrand for Disk {
     }
 
     fn autocov(&self, h: &[f64]) -> Option<f64> {
-        let (hx, hy) = (nearest_image(h[0]), nearest_image(h[1]));
-        let mut overlap = 0.0;
         // With r ≤ ½ only images within one period can overlap.
         let reach2 = 4.0 * self.r * self.r;
-        for mx in -1..=1 {
-            for my in -1..=1 {
-                let (dx, dy) = (hx + mx as f64, hy + my as f64);
-                let d2 = dx * dx + dy * dy;
-                if d2 < reach2 {
-                    overlap += self.lens(d2.sqrt());
-                }
+        let overlap = sum_over_images(h, |t| {
+            let d2 = t[0] * t[0] + t[1] * t[1];
+            if d2 < reach2 {
+                self.lens(d2.sqrt())
+            } else {
+                0.0
             }
-        }
+        });
         Some(overlap - self.area() * self.area())
     }
 

@@ -11,8 +11,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::{Integrand, IntegrandClass};
-use crate::integrands::disk::nearest_image;
+use super::{Integrand, IntegrandClass, nearest_image};
 use crate::spectrum::phase::{exp_neg_2pi_i, reduced_phase};
 
 /// Exponents beyond this contribute below 1e-17 relative.

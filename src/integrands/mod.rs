@@ -107,6 +107,28 @@ pub enum IntegrandError {
     },
 }
 
+/// x reduced to its nearest periodic image, in [−½, ½].
+#[inline]
+pub(crate) fn nearest_image(x: f64) -> f64 {
+    x - x.round()
+}
+
+/// The periodic autocorrelation ∫ f(x) f(x+h) dx of a shape that overlaps
+/// its translates only within one period: the sum, over the images
+/// t = h + m (h reduced to its nearest image, m ∈ {−1, 0, 1}²), of the
+/// overlap area of the shape with itself shifted by t.
+#[inline]
+pub(crate) fn sum_over_images(h: &[f64], overlap: impl Fn([f64; 2]) -> f64) -> f64 {
+    let (hx, hy) = (nearest_image(h[0]), nearest_image(h[1]));
+    let mut total = 0.0;
+    for mx in -1..=1 {
+        for my in -1..=1 {
+            total += overlap([hx + mx as f64, hy + my as f64]);
+        }
+    }
+    total
+}
+
 /// sin(x)/x, 1 at 0.
 #[inline]
 pub(crate) fn sinc(x: f64) -> f64 {

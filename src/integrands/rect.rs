@@ -7,8 +7,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::{Integrand, IntegrandClass, sinc_pi};
-use crate::integrands::disk::nearest_image;
+use super::{Integrand, IntegrandClass, nearest_image, sinc_pi, sum_over_images};
 use crate::spectrum::phase::exp_neg_2pi_i;
 
 /// Periodized rotated-rectangle indicator.
@@ -96,18 +95,11 @@ impl Integrand for Rect {
     }
 
     fn autocov(&self, h: &[f64]) -> Option<f64> {
-        let (hx, hy) = (nearest_image(h[0]), nearest_image(h[1]));
-        let mut overlap = 0.0;
-        for mx in -1..=1 {
-            for my in -1..=1 {
-                let t = [hx + mx as f64, hy + my as f64];
-                let a = self.w - (t[0] * self.e1[0] + t[1] * self.e1[1]).abs();
-                let b = self.h - (t[0] * self.e2[0] + t[1] * self.e2[1]).abs();
-                if a > 0.0 && b > 0.0 {
-                    overlap += a * b;
-                }
-            }
-        }
+        let overlap = sum_over_images(h, |t| {
+            let a = self.w - (t[0] * self.e1[0] + t[1] * self.e1[1]).abs();
+            let b = self.h - (t[0] * self.e2[0] + t[1] * self.e2[1]).abs();
+            if a > 0.0 && b > 0.0 { a * b } else { 0.0 }
+        });
         Some(overlap - self.area() * self.area())
     }
 

@@ -112,7 +112,12 @@ where
         Method::Fast { tolerance },
         sets,
         |r| -> Result<PointSet, VarianceError> {
-            let set = realization(r)?;
+            // Realization 0 was drawn above for N and d: lend it, do not redraw.
+            let set = if r == 0 {
+                first.clone()
+            } else {
+                realization(r)?
+            };
             if set.len() != n {
                 return Err(VarianceError::MixedSizes {
                     first: n,

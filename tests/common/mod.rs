@@ -1,0 +1,41 @@
+//! Helpers shared by the command-line test files (each test file is its own
+//! crate and uses a subset, hence the `dead_code` allowance).
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+/// Runs the built `varspec` binary with `args`.
+pub fn varspec(args: &[&str]) -> Output {
+    varspec_with(args, None)
+}
+
+/// Runs `varspec` with `RAYON_NUM_THREADS` set when `threads` is given.
+pub fn varspec_with(args: &[&str], threads: Option<&str>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_varspec"));
+    cmd.args(args);
+    if let Some(t) = threads {
+        cmd.env("RAYON_NUM_THREADS", t);
+    }
+    cmd.output().expect("the varspec binary runs")
+}
+
+/// A fresh folder for one test's files.
+pub fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("varspec-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Asserts that `varspec args` fails with a message containing `phrase`
+/// and without a panic.
+pub fn assert_fails(args: &[&str], phrase: &str) {
+    let out = varspec(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} should fail");
+    assert!(
+        err.contains(phrase),
+        "{args:?}: {err:?} should contain {phrase:?}"
+    );
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+}
