@@ -1,5 +1,5 @@
 //! The crate-wide error type: one enum wrapping each module's typed errors, so
-//! callers can match on the exact condition (STYLE.md §9).
+//! callers can match on the exact condition (docs/architecture.md, "Conventions").
 
 use crate::io::pointfile::PointFileError;
 use crate::points::PointSetError;

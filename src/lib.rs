@@ -2,7 +2,7 @@
 //! produce.
 //!
 //! The crate is library first; the `varspec` binary is a thin command-line
-//! layer over it (see `DESIGN.md` §3 of the project). Data flows one way:
+//! layer over it (see docs/architecture.md). Data flows one way:
 //! a [`samplers::Sampler`] produces [`points::PointSet`]s, which analyses and
 //! reports consume. Randomness only enters through an explicit seeded
 //! generator handed down ([`rng`]), so a seed fixes every output bit for any

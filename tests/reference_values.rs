@@ -1,6 +1,7 @@
 //! Sampler-level predictions against exact expected variances computed
-//! outside the project (../shared/reference/expected-variance.csv, closed
-//! forms for random and jitter, relative accuracy ~1e-6).
+//! outside the project (tests/data/expected-variance.csv, closed forms for
+//! random and jitter, relative accuracy ~1e-6; provenance in
+//! tests/data/README.md).
 
 use varspec::integrands;
 use varspec::rng::set_rng;
@@ -12,12 +13,8 @@ use varspec::variance::{VarianceError, fourier, spatial};
 const Z: f64 = 4.0;
 
 fn rows() -> Vec<(String, String, usize, f64)> {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../shared/reference/expected-variance.csv"
-    );
-    let text = std::fs::read_to_string(path)
-        .unwrap_or_else(|e| panic!("{path}: {e} (CI clones the project with ../shared beside it)"));
+    // Compiled in, so the test cannot run without its reference values.
+    let text = include_str!("data/expected-variance.csv");
     text.lines()
         .skip(1)
         .filter(|l| !l.trim().is_empty())

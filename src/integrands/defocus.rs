@@ -1,4 +1,4 @@
-//! A thin-lens light field (DESIGN.md §1): f(x,y,u,v) = g(x + c(u−½),
+//! A thin-lens light field (docs/mathematics.md): f(x,y,u,v) = g(x + c(u−½),
 //! y + c(v−½)) with g a 2D shape centred at (½,½). Depth of field shears the
 //! light field by c = (F − d)/d (Singh & Jarosz 2017, §3).
 //!

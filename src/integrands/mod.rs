@@ -1,5 +1,5 @@
 //! Reference integrands with exact integral, Fourier coefficients and (in
-//! 2D) periodic autocovariance (DESIGN.md §1).
+//! 2D) periodic autocovariance (docs/mathematics.md).
 //!
 //! Every integrand is a function on the unit torus; F_f(k) are its Fourier
 //! coefficients, P_f(k) = |F_f(k)|², and
@@ -54,7 +54,7 @@ pub trait Integrand: Send + Sync {
 }
 
 /// What the convergence theory needs to know of an integrand
-/// (Pilleboue et al. 2015, Table 1; DESIGN.md §1).
+/// (Pilleboue et al. 2015, Table 1; docs/mathematics.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct IntegrandClass {
     /// C^∞ (Gaussian, cosine) rather than discontinuous (indicators).

@@ -1,4 +1,4 @@
-//! Point-set files (DESIGN.md §2).
+//! Point-set files (docs/formats.md).
 //!
 //! * **CSV** — a header `x0,x1,…,x{d−1}`, optionally preceded by a `set`
 //!   column that numbers realizations 0, 1, 2, … in order; one point per

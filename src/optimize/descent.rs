@@ -1,4 +1,4 @@
-//! Gradient descent on point positions (DESIGN.md §4): minimize
+//! Gradient descent on point positions (docs/mathematics.md §6): minimize
 //! L(X) = Σ_(0<|k|∞≤K) W(k)·P_S(k), P_S = |S|²/N², S(k) = Σ_j e^(−2πik·x_j),
 //! on the torus, with the gradient
 //! ∂L/∂x_j = (2/N²) Σ_k W(k) Re[conj(S(k))·(−2πik)·e^(−2πik·x_j)].

@@ -1,4 +1,4 @@
-//! Optimizers (DESIGN.md §4): gradient descent on point positions to
+//! Optimizers (docs/mathematics.md §6): gradient descent on point positions to
 //! minimize a weighted spectral loss ([`descent`], weights from
 //! [`target`]), and the shear search for structured 4D sets ([`shear`]).
 

@@ -1,5 +1,5 @@
 //! Optimization targets: the weight W(k) of the loss
-//! L(X) = Σ_(0<|k|∞≤K) W(k)·P_S(k) (DESIGN.md §4).
+//! L(X) = Σ_(0<|k|∞≤K) W(k)·P_S(k) (docs/mathematics.md §6).
 //!
 //! * an integrand spec: W = P_f, so L is the predicted variance itself
 //!   (within the box);

@@ -1,7 +1,7 @@
 //! Stratified sampling on the m^d grid: regular (cell centres), jittered (an
 //! independent uniform offset per stratum) and uniform jitter (one offset
 //! shared by all strata) are one sampler with the offset as a parameter
-//! (STYLE.md §3).
+//! (docs/architecture.md, "Conventions").
 //!
 //! Jitter's expected power spectrum is E[N·P_S(k)] = 1 − Π_j sinc²(π k_j/m)
 //! (Pilleboue et al. 2015, "Variance analysis for Monte Carlo integration",

@@ -2,7 +2,7 @@
 //! the registry ([`SAMPLERS`]) that names them for the command line.
 //!
 //! A sampler is an immutable configuration (N, d, parameters); randomness is
-//! handed in as a [`SetRng`] (STYLE.md §2). [`generate_sets`] draws many
+//! handed in as a [`SetRng`] (docs/architecture.md, "Conventions"). [`generate_sets`] draws many
 //! realizations in parallel, realization r from stream (seed, r), so the
 //! output is identical for any number of threads.
 

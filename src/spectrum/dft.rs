@@ -1,5 +1,5 @@
 //! The direct (naive) discrete Fourier sums: the exact reference every fast
-//! path is checked against (like RustFFT's naive `Dft`, STYLE.md §6).
+//! path is checked against (like RustFFT's naive `Dft`, docs/architecture.md, "Conventions").
 //!
 //! Every exponential uses exact phase reduction ([`super::phase`]), so
 //! frequencies up to 10^4 keep 1e-12 accuracy.

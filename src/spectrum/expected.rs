@@ -1,4 +1,4 @@
-//! The expected power spectrum E[N·P_S(k)] (DESIGN.md §1: "power"; white
+//! The expected power spectrum E[N·P_S(k)] (docs/mathematics.md: "power"; white
 //! noise ≈ 1 away from DC) averaged over realizations.
 
 use rayon::prelude::*;

@@ -1,4 +1,4 @@
-//! Sample spectra (DESIGN.md §1): S(k) = Σ_j e^(−2πi k·x_j) on a frequency
+//! Sample spectra (docs/mathematics.md): S(k) = Σ_j e^(−2πi k·x_j) on a frequency
 //! box, exactly ([`dft`]) or by non-uniform FFT ([`nufft`]); the expected
 //! power E[N·P_S(k)] over realizations ([`expected`]); radial averages and
 //! anisotropy ([`radial`]); the pair correlation function ([`pcf`]).

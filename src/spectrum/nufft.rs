@@ -15,7 +15,7 @@
 //! the relative error is about ε (BMK 2019, §3 and Eq. (3.2)): |ΔF(k)| ≲
 //! ε·Σ_j |c_j|.
 //!
-//! A plan is a value (STYLE.md §4): designed once for (d, h, ε), `Send +
+//! A plan is a value (docs/architecture.md, "Conventions"): designed once for (d, h, ε), `Send +
 //! Sync`, reused across realizations with caller-supplied scratch.
 
 use std::sync::Arc;

@@ -1,6 +1,6 @@
 //! Convergence rates: the least-squares slope of log Var against log N with
 //! its 95% confidence interval (Student t with n − 2 degrees of freedom on
-//! the residual scatter), and the theoretical rates of DESIGN.md §1
+//! the residual scatter), and the theoretical rates of docs/mathematics.md
 //! (Pilleboue et al. 2015, Table 1; Singh & Jarosz 2017).
 
 use crate::integrands::IntegrandClass;

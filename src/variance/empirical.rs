@@ -71,8 +71,8 @@ where
 
 /// As [`empirical`], but the random shift moves only the dimensions in
 /// `shift_dims` (none: the unshifted estimator of a randomized sampler,
-/// e.g. sheared multi-jitter, which is unbiased without a shift; DESIGN.md
-/// §4 explains why a shift in u, v would undo a shear).
+/// e.g. sheared multi-jitter, which is unbiased without a shift; docs/mathematics.md
+/// §6 explains why a shift in u, v would undo a shear).
 ///
 /// # Errors
 /// As [`empirical`], plus a shift dimension out of range.

@@ -1,4 +1,4 @@
-//! The Fourier form (DESIGN.md §1; Pilleboue et al. 2015, Eq. (9) on the
+//! The Fourier form (docs/mathematics.md; Pilleboue et al. 2015, Eq. (9) on the
 //! torus): Var[Î] = Σ_(k≠0) E[P_S(k)]·P_f(k), truncated to a frequency box B
 //! and completed by the Parseval tail: Σ_(k∉B) P_f(k) = c_f(0) − Σ_(k∈B\0)
 //! P_f(k) exactly, weighted by 1/N, the white-noise level E[P_S] tends to

@@ -1,5 +1,5 @@
 //! Three independent predictors of Var[Î] for the shift-randomized
-//! estimator Î(s) = (1/N) Σ_j f(x_j + s mod 1) (DESIGN.md §1), which must
+//! estimator Î(s) = (1/N) Σ_j f(x_j + s mod 1) (docs/mathematics.md), which must
 //! agree: [`spatial`] (exact, to rounding), [`fourier`] (within its reported
 //! truncation bound) and [`empirical`] (within its confidence interval);
 //! and the convergence-rate fit ([`convergence`]).

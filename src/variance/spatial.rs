@@ -1,4 +1,4 @@
-//! The spatial form (DESIGN.md §1; the torus version of Öztireli 2016,
+//! The spatial form (docs/mathematics.md; the torus version of Öztireli 2016,
 //! "Integration with stochastic point processes", ACM TOG 35(5), Eq. (9)):
 //!
 //! Var_s[Î] = (1/N²) Σ_(i,j) c_f(x_i − x_j)
