@@ -1,5 +1,5 @@
 //! `varspec predict`, `converge`, `integrands` and `experiment` as scripts
-//! use them: the JSON keys of DESIGN.md §2, errors, determinism.
+//! use them: the JSON keys of docs/cli.md, errors, determinism.
 
 mod common;
 use common::{varspec, varspec_with};

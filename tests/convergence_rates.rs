@@ -1,4 +1,4 @@
-//! Convergence rates against theory (DESIGN.md §1; Pilleboue et al. 2015):
+//! Convergence rates against theory (docs/mathematics.md; Pilleboue et al. 2015):
 //! the least-squares slope of the sampler-level spatial prediction against N
 //! must contain the theoretical rate in its 95% CI (Student t on the
 //! residual scatter, which includes the realizations' sampling noise), and

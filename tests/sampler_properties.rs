@@ -1,4 +1,4 @@
-//! Structural properties of every sampler (STYLE.md §7): strata, N-rooks
+//! Structural properties of every sampler (docs/architecture.md, "Conventions"): strata, N-rooks
 //! intervals, Poisson-disk distances, net intervals; checked on random seeds
 //! and sizes by proptest.
 

@@ -1,4 +1,4 @@
-//! Fast transforms against the direct reference (STYLE.md §6), spectra with
+//! Fast transforms against the direct reference (docs/architecture.md, "Conventions"), spectra with
 //! closed forms, large-frequency phase accuracy.
 
 use rustfft::num_complex::Complex64;

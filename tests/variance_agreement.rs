@@ -1,4 +1,4 @@
-//! The project's core regression test (DESIGN.md §1): the three predictors
+//! The project's core regression test (docs/mathematics.md): the three predictors
 //! agree for every classic sampler, reference integrand and
 //! N ∈ {64, 256, 1024}:
 //! * spatial vs Fourier on the same 12 realizations, within the Fourier
