@@ -127,6 +127,22 @@ proptest! {
     }
 
     #[test]
+    fn padded_halves_keep_their_structure(seed: u64, m in 1usize..14) {
+        // Jittered (x, y), N-rooks (u, v): each half keeps its own
+        // stratification through the random pairing.
+        let n = m * m;
+        let set = draw("padded", n, 4, &[("xy", "jitter"), ("uv", "nrooks")], seed);
+        prop_assert!(one_per_cell(&set, &[0, 1], &[m, m]));
+        prop_assert!(latin(&set, 2) && latin(&set, 3));
+        // The shorthand name:key=value gives the same sets.
+        let shorthand = varspec::samplers::build("padded:xy=jitter,uv=nrooks", n, Some(4), &[])
+            .unwrap()
+            .sample(&mut varspec::rng::set_rng(seed, 0))
+            .unwrap();
+        prop_assert_eq!(&shorthand, &set);
+    }
+
+    #[test]
     fn poisson_disk_keeps_its_minimum_distance(seed: u64, n in 1usize..400, d in 2usize..5, rho in 0.3f64..0.75) {
         let rho_text = rho.to_string();
         let set = draw("poisson-disk", n, d, &[("radius", &rho_text)], seed);

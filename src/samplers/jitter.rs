@@ -7,10 +7,13 @@
 //! (Pilleboue et al. 2015, "Variance analysis for Monte Carlo integration",
 //! ACM TOG 34(4), §5), zero at every nonzero multiple of m.
 
+use rustfft::num_complex::Complex64;
+
 use super::registry::{Config, integer_root, pow_saturating};
 use super::{Sampler, SamplerError};
 use crate::points::{PointSet, stratum_coord};
 use crate::rng::{SetRng, uniform};
+use crate::spectrum::pair::{PairSpectrum, geometric, turn, uniform_char};
 
 /// Where in its stratum each point lies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -100,5 +103,40 @@ impl Sampler for Jitter {
             }
         }
         Ok(PointSet::new(d, coords).expect("stratum coordinates lie in [0,1)"))
+    }
+
+    fn pair_spectrum(&self) -> Option<&dyn PairSpectrum> {
+        (self.dim == 2).then_some(self as &dyn PairSpectrum)
+    }
+}
+
+/// One point per cell of the m×m grid (2D): with μ_s(ω) = E[e^(2πiω·q_s)]
+/// the mean phasor of stratum s,
+/// C(ω, ω′) = Σ_(s≠s′) E[e^(2πi(ω·q_s − ω′·q_s′))]
+///          = o(ω, ω′)·(A(ω)·conj(A(ω′)) − A(ω − ω′)),
+/// A(ω) = Σ_cells e^(2πiω·c/m) (a product of two geometric sums) and o the
+/// offsets' factor: χ(ω/m)·conj(χ(ω′/m)) for independent offsets,
+/// e^(πi(ω−ω′)/m) per axis for cell centres, χ((ω − ω′)/m) for one shared
+/// offset (uniform jitter). The diagonal A(ω − ω′) is subtracted in the
+/// same factored form, so no pair is visited: O(1) per frequency pair.
+impl PairSpectrum for Jitter {
+    fn points(&self) -> usize {
+        self.points_per_set()
+    }
+
+    fn pair_sum(&self, w1: [f64; 2], w2: [f64; 2]) -> Complex64 {
+        let m = self.m;
+        let mf = m as f64;
+        let cells = |w: [f64; 2]| geometric(w[0] / mf, m) * geometric(w[1] / mf, m);
+        let delta = [w1[0] - w2[0], w1[1] - w2[1]];
+        let offsets = match self.offset {
+            StratumOffset::Independent => {
+                let chi = |w: [f64; 2]| uniform_char(w[0] / mf) * uniform_char(w[1] / mf);
+                chi(w1) * chi(w2).conj()
+            }
+            StratumOffset::Centre => turn(0.5 * (delta[0] + delta[1]) / mf),
+            StratumOffset::Shared => uniform_char(delta[0] / mf) * uniform_char(delta[1] / mf),
+        };
+        offsets * (cells(w1) * cells(w2).conj() - cells(delta))
     }
 }

@@ -11,27 +11,28 @@ mod jitter;
 mod multijitter;
 mod nrooks;
 mod optimized;
+mod padded;
 mod poisson_disk;
 mod random;
 mod registry;
 mod sobol;
 mod sobol_table;
-mod umj;
 
 pub use halton::Halton;
 pub use jitter::{Jitter, StratumOffset};
 pub use multijitter::MultiJitter;
 pub use nrooks::NRooks;
+pub use padded::Padded;
 pub use poisson_disk::{PoissonDisk, packing_radius};
 pub use random::Random;
 pub use registry::{DimRange, ParamInfo, SAMPLERS, SamplerInfo, build, build_nearest, find};
 pub use sobol::Sobol;
-pub use umj::Umj;
 
 use rayon::prelude::*;
 
 use crate::points::PointSet;
 use crate::rng::{SetRng, set_rng};
+use crate::spectrum::pair::PairSpectrum;
 
 /// A point-set generator: N points in d dimensions per call.
 pub trait Sampler: Send + Sync {
@@ -44,6 +45,17 @@ pub trait Sampler: Send + Sync {
     /// # Errors
     /// Only samplers that can fail to place N points (Poisson disk) do.
     fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError>;
+    /// The expected pair sums C(ω, ω′) in closed form, for 2D samplers that
+    /// have one ([`PairSpectrum`]); `None` otherwise.
+    fn pair_spectrum(&self) -> Option<&dyn PairSpectrum> {
+        None
+    }
+    /// The (x, y) and (u, v) samplers of a padded 4D sampler (independent
+    /// 2D halves paired by a uniformly random permutation); `None` for
+    /// every other sampler.
+    fn halves(&self) -> Option<[&dyn Sampler; 2]> {
+        None
+    }
 }
 
 /// What is wrong with a sampler request.
@@ -100,6 +112,14 @@ pub enum SamplerError {
         n: usize,
         /// Requested d.
         dim: usize,
+    },
+    /// Malformed `name:key=value,...` text.
+    #[error("sampler `{spec}`: `{part}` is not key=value")]
+    Syntax {
+        /// The whole spec.
+        spec: String,
+        /// The offending part.
+        part: String,
     },
     /// A parameter the sampler does not have.
     #[error("{sampler}: unknown parameter `{key}`; its parameters: {known}")]

@@ -11,10 +11,13 @@
 //! shuffles every column and row independently; CMJ uses one σ for all
 //! columns and one τ for all rows.
 
+use rustfft::num_complex::Complex64;
+
 use super::registry::Config;
 use super::{Sampler, SamplerError};
 use crate::points::{PointSet, stratum_coord};
 use crate::rng::{SetRng, permutation, uniform};
+use crate::spectrum::pair::{PairSpectrum, distinct_pair_mean, geometric, uniform_char};
 
 /// Multi-jittered N = m·n points in 2D.
 #[derive(Debug, Clone)]
@@ -111,5 +114,64 @@ impl Sampler for MultiJitter {
         let mut coords = vec![0.0; 2 * self.points_per_set()];
         self.fill(rng, &mut coords);
         Ok(PointSet::new(2, coords).expect("stratum coordinates lie in [0,1)"))
+    }
+
+    fn pair_spectrum(&self) -> Option<&dyn PairSpectrum> {
+        Some(self)
+    }
+}
+
+/// C(ω, ω′) in closed form. The x coordinates depend only on the σ shuffles
+/// and x offsets, the y coordinates only on τ and the y offsets, so each
+/// pair's expectation is an x factor times a y factor, and the sum over the
+/// pairs (i, j) ≠ (i′, j′) splits into three cases — other column and other
+/// row (A), same column (B), same row (C) — each a product of geometric
+/// sums over columns, rows and fine intervals.
+///
+/// Multi-jitter (σ_i, τ_j independent per column and row): a point of
+/// column i is uniform over the column, two points of one column sit in
+/// distinct fine intervals drawn without replacement:
+/// C = P_x·P_y + W_x·P_y + P_x·W_y, with P_x = χ(ω_x/m)conj(χ(ω′_x/m))·Q_x
+/// (pairs of distinct columns) and W_x = D_x·χ(ω_x/N)conj(χ(ω′_x/N))·R_x
+/// (pairs within a column).
+///
+/// CMJ (one σ, one τ): the fine interval of x depends on the row j only, so
+/// two points in distinct rows have distinct σ values (R_x) and two in one
+/// row share it (U_x):
+/// C = c_x c_y (Q_x Q_y R_x R_y + D_x Q_y R_x U_y + Q_x D_y U_x R_y).
+///
+/// Here Q_x = Σ_(i≠i′) e^(2πi(ω_x i − ω′_x i′)/m), D_x = Σ_i e^(2πi(ω_x−ω′_x)i/m),
+/// R_x the mean of e^(2πi(ω_x t − ω′_x t′)/N) over distinct t, t′ < n,
+/// U_x = (1/n) Σ_(t<n) e^(2πi(ω_x−ω′_x)t/N), c_x = χ(ω_x/N)conj(χ(ω′_x/N)),
+/// and the y terms likewise with the roles of m and n exchanged.
+impl PairSpectrum for MultiJitter {
+    fn points(&self) -> usize {
+        self.points_per_set()
+    }
+
+    fn pair_sum(&self, w1: [f64; 2], w2: [f64; 2]) -> Complex64 {
+        let (m, n) = (self.columns, self.rows);
+        let total = (m * n) as f64;
+        // Per axis: (coarse cells, fine intervals per cell, ω, ω′).
+        let axis = |cells: usize, fine: usize, a: f64, b: f64| {
+            let c = cells as f64;
+            let q = geometric(a / c, cells) * geometric(b / c, cells).conj()
+                - geometric((a - b) / c, cells);
+            let d = geometric((a - b) / c, cells);
+            let offsets = uniform_char(a / total) * uniform_char(b / total).conj();
+            let r = distinct_pair_mean(a / total, b / total, fine);
+            let u = geometric((a - b) / total, fine) / fine as f64;
+            let coarse = uniform_char(a / c) * uniform_char(b / c).conj();
+            (q, d, offsets, r, u, coarse)
+        };
+        let (qx, dx, cx, rx, ux, px) = axis(m, n, w1[0], w2[0]);
+        let (qy, dy, cy, ry, uy, py) = axis(n, m, w1[1], w2[1]);
+        if self.correlated {
+            cx * cy * (qx * qy * rx * ry + dx * qy * rx * uy + qx * dy * ux * ry)
+        } else {
+            let (pair_x, pair_y) = (px * qx, py * qy);
+            let (within_x, within_y) = (dx * cx * rx, dy * cy * ry);
+            pair_x * pair_y + within_x * pair_y + pair_x * within_y
+        }
     }
 }

@@ -1,10 +1,13 @@
 //! Independent uniform points: the white-noise baseline, E[N·P_S(k)] = 1 for
 //! every k ≠ 0.
 
+use rustfft::num_complex::Complex64;
+
 use super::registry::Config;
 use super::{Sampler, SamplerError};
 use crate::points::PointSet;
 use crate::rng::{SetRng, uniform};
+use crate::spectrum::pair::{PairSpectrum, uniform_char};
 
 /// N independent uniform points in [0,1)^d.
 #[derive(Debug, Clone)]
@@ -36,5 +39,23 @@ impl Sampler for Random {
     fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError> {
         let coords = (0..self.n * self.dim).map(|_| uniform(rng)).collect();
         Ok(PointSet::new(self.dim, coords).expect("uniform draws lie in [0,1)"))
+    }
+
+    fn pair_spectrum(&self) -> Option<&dyn PairSpectrum> {
+        (self.dim == 2).then_some(self as &dyn PairSpectrum)
+    }
+}
+
+/// Independent points: C(ω, ω′) = N(N−1)·χ(ω)·conj(χ(ω′)), χ the
+/// characteristic function of a uniform point.
+impl PairSpectrum for Random {
+    fn points(&self) -> usize {
+        self.n
+    }
+
+    fn pair_sum(&self, w1: [f64; 2], w2: [f64; 2]) -> Complex64 {
+        let n = self.n as f64;
+        let chi = |w: [f64; 2]| uniform_char(w[0]) * uniform_char(w[1]);
+        chi(w1) * chi(w2).conj() * (n * (n - 1.0))
     }
 }

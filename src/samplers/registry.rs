@@ -3,7 +3,7 @@
 //! (`varspec sample --list`) and [`build`] read.
 
 use super::{Sampler, SamplerError};
-use super::{halton, jitter, multijitter, nrooks, optimized, poisson_disk, random, sobol, umj};
+use super::{halton, jitter, multijitter, nrooks, optimized, padded, poisson_disk, random, sobol};
 
 /// The dimensions a sampler supports and the one it uses by default.
 #[derive(Debug, Clone, Copy)]
@@ -153,7 +153,31 @@ pub const SAMPLERS: &[SamplerInfo] = &[
                 help: "grid columns of each 2D set (a divisor of N); auto = largest divisor <= sqrt(N)",
             },
         ],
-        build: umj::from_config,
+        build: padded::umj_from_config,
+    },
+    SamplerInfo {
+        name: "padded",
+        aliases: &[],
+        summary: "4D (x,y,u,v): any 2D sampler on (x,y) and any on (u,v), paired by a random permutation (Cook 1986)",
+        dims: DimRange {
+            min: 4,
+            max: 4,
+            default: 4,
+        },
+        count: "an N both 2D samplers accept",
+        params: &[
+            ParamInfo {
+                key: "xy",
+                default: "jitter",
+                help: "2D sampler of (x,y), with its default parameters",
+            },
+            ParamInfo {
+                key: "uv",
+                default: "jitter",
+                help: "2D sampler of (u,v), with its default parameters",
+            },
+        ],
+        build: padded::padded_from_config,
     },
     SamplerInfo {
         name: "poisson-disk",
@@ -316,6 +340,24 @@ pub fn build(
     dim: Option<usize>,
     params: &[(String, String)],
 ) -> Result<Box<dyn Sampler>, SamplerError> {
+    // `name:key=value,...` is shorthand for `name` with those parameters;
+    // parameters given separately come later and win.
+    let (name, params) = match name.split_once(':') {
+        None => (name, params.to_vec()),
+        Some((name, rest)) => {
+            let mut all = Vec::new();
+            for part in rest.split(',').filter(|p| !p.is_empty()) {
+                let (k, v) = part.split_once('=').ok_or_else(|| SamplerError::Syntax {
+                    spec: format!("{name}:{rest}"),
+                    part: part.to_string(),
+                })?;
+                all.push((k.trim().to_string(), v.trim().to_string()));
+            }
+            all.extend_from_slice(params);
+            (name, all)
+        }
+    };
+    let params = params.as_slice();
     let info = find(name)?;
     let sampler = info.name;
     let dim = dim.unwrap_or(info.dims.default);

@@ -7,6 +7,7 @@ pub mod dft;
 pub mod expected;
 pub mod frequencies;
 pub mod nufft;
+pub mod pair;
 pub mod pcf;
 pub mod phase;
 pub mod radial;
