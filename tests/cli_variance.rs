@@ -300,6 +300,13 @@ fn optimize_commands_write_sets_and_reports() {
         dir.join("sheared.csv").to_str().unwrap(),
     ]);
     assert_eq!(shear["shear"].as_array().unwrap().len(), 2);
+    // The analytic shear is −0.6 on both axes; the sign matters.
+    for a in shear["shear"].as_array().unwrap() {
+        assert!((a.as_f64().unwrap() + 0.6).abs() <= 0.02, "{shear}");
+    }
+    assert_eq!(shear["double_wedge"], false);
+    assert!(shear["objective"]["stderr"].as_f64().unwrap() <= 0.02);
+    assert!(shear["initial_shear"].as_array().unwrap().len() == 2);
     for key in ["variance_before", "variance_after"] {
         for field in ["variance", "ci_low", "ci_high"] {
             assert!(shear[key][field].as_f64().is_some(), "{key}.{field}");

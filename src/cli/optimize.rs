@@ -26,28 +26,27 @@ pub enum OptimizeCommand {
 
 #[derive(clap::Args)]
 pub struct ShearArgs {
-    /// 4D sampler to shear (umj: multi-jittered (x,y) and (u,v) pairs).
+    /// Padded 4D sampler to shear: umj, or padded:xy=SAMPLER,uv=SAMPLER.
     #[arg(long, default_value = "umj")]
     sampler: String,
     /// Points per set.
     #[arg(short = 'n')]
     n: usize,
-    /// 4D integrand, e.g. defocus:shape=box,size=0.3,c=0.6.
+    /// 4D light field, e.g. defocus:shape=box,size=0.3,c=0.6 or layers:c1=0.5,c2=-0.2.
     #[arg(long)]
     integrand: String,
-    /// Realizations of the objective (common random numbers).
+    /// Sheared sets written with -o (the search itself uses the expected
+    /// variance over the sampler's randomness, not these sets).
     #[arg(long, default_value_t = 16)]
     sets: usize,
-    /// Seed.
+    /// Seed of the written sets, of the independent check and of any
+    /// realizations behind an estimated half.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Box |k|∞ ≤ half from which the integrand's spectral support is taken.
-    #[arg(long, default_value_t = 8)]
-    half: usize,
-    /// Shears scanned in [−range, range] before Nelder–Mead.
+    /// Shears searched in [−range, range] on each axis.
     #[arg(long, default_value_t = 2.0)]
     range: f64,
-    /// Realizations of the before/after variance estimates.
+    /// Fresh realizations of the independent before/after check (0: skip it).
     #[arg(long, default_value_t = 4000)]
     realizations: usize,
     /// Write the sheared sets here (CSV).
@@ -244,8 +243,12 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
 
 fn shear(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::integrands;
-    use varspec::optimize::shear::{ShearObjective, search_shear, shear_set};
+    use varspec::optimize::shear::{
+        ObjectiveOptions, SENSITIVITY_STEP, ShearObjective, Sheared, search_shear, shear_set,
+        spectral_start,
+    };
     use varspec::report::plot::spectrum_png;
+    use varspec::samplers::Sampler;
     use varspec::spectrum::{FrequencyBox, Method, expected_power};
     use varspec::variance::{VarianceError, empirical_shifting};
 
@@ -257,37 +260,48 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             f.dim()
         );
     }
-    if a.sets == 0 || a.realizations < 2 || a.range.is_nan() || a.range <= 0.0 {
-        bail!("--sets must be >= 1, --realizations >= 2 and --range > 0");
+    if a.realizations == 1 || !(a.range.is_finite() && a.range > 0.0) {
+        bail!(
+            "--realizations must be 0 (no check) or at least 2, and --range a finite positive number (got {})",
+            a.range
+        );
     }
     let sampler = samplers::build(&a.sampler, a.n, Some(4), &[])?;
     let start = Instant::now();
-    let crn: Vec<_> = (0..a.sets as u64)
-        .map(|r| sampler.sample(&mut set_rng(a.seed, r)))
-        .collect::<Result<_, _>>()?;
-    let objective = ShearObjective::new(f.as_ref(), crn.clone(), a.half)?;
-    let support = objective.support_len();
-    let found = search_shear(objective, a.range, 16)?;
+    let spectral = spectral_start(f.as_ref(), 64, a.range);
+    let mut starts = spectral.candidates();
+    starts.push([0.0, 0.0]);
+    let options = ObjectiveOptions {
+        seed: a.seed,
+        ..ObjectiveOptions::default()
+    };
+    let objective = ShearObjective::new(f.as_ref(), sampler.as_ref(), &starts, options)?;
+    let found = search_shear(&objective, &spectral, a.range)?;
     let search_seconds = start.elapsed().as_secs_f64();
-    // Before and after on fresh realizations, unshifted estimator.
+    // An independent check on fresh realizations: the same estimator, by
+    // evaluating f (no spectra).
     let eval_seed = a.seed ^ 0x0e7a_1000;
     let estimate = |shear: [f64; 2]| -> anyhow::Result<_> {
+        let sheared = Sheared::new(sampler.as_ref(), shear)?;
         Ok(empirical_shifting(
             f.as_ref(),
             a.realizations,
             a.seed ^ 1,
-            &[],
+            &[0, 1],
             |r| -> Result<_, VarianceError> {
-                let set = sampler.sample(&mut set_rng(eval_seed, r as u64))?;
-                shear_set(&set, shear).map_err(|e| {
-                    VarianceError::Spectrum(varspec::spectrum::SpectrumError::Pcf(e.to_string()))
-                })
+                Ok(sheared.sample(&mut set_rng(eval_seed, r as u64))?)
             },
         )?)
     };
-    let before = estimate([0.0, 0.0])?;
-    let after = estimate(found.shear)?;
-    let sheared: Vec<_> = crn
+    let check = if a.realizations >= 2 {
+        Some((estimate([0.0, 0.0])?, estimate(found.shear)?))
+    } else {
+        None
+    };
+    let sets: Vec<_> = (0..a.sets as u64)
+        .map(|r| sampler.sample(&mut set_rng(a.seed, r)))
+        .collect::<Result<_, _>>()?;
+    let sheared: Vec<_> = sets
         .iter()
         .map(|s| shear_set(s, found.shear))
         .collect::<Result<_, _>>()?;
@@ -296,7 +310,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     }
     if let Some(prefix) = &a.png_prefix {
         let freqs = FrequencyBox::from_resolution(2, 64);
-        for (label, sets) in [("before", &crn), ("after", &sheared)] {
+        for (label, sets) in [("before", &sets), ("after", &sheared)] {
             for (name, dims) in [("xu", [0usize, 2]), ("yv", [1, 3])] {
                 let spectrum = expected_power(
                     freqs,
@@ -319,34 +333,70 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             }
         }
     }
-    let analytic = f.spec().strip_prefix("defocus:").and_then(|rest| {
-        rest.split(',')
-            .find_map(|kv| kv.strip_prefix("c="))
-            .and_then(|c| c.parse::<f64>().ok())
-            .map(|c| [-c, -c])
-    });
+    let analytic = f.light_field().map(|l| l.layer_shears());
+    let relative_stderr = found.optimum.stderr / found.optimum.value;
+    let plane = |p: &varspec::optimize::shear::PlaneDirections| {
+        json!({"principal_slope": p.principal, "eigenvalue_ratio": p.eigenvalue_ratio,
+               "line_slopes": p.lines, "first_line_share": p.first_line_share,
+               "second_line_share": p.second_line_share, "one_line_misfit": p.one_line_misfit})
+    };
+    let ci = |e: &varspec::variance::EmpiricalEstimate| json!({"variance": e.variance, "ci_low": e.ci_low, "ci_high": e.ci_high, "realizations": e.realizations});
+    let d = SENSITIVITY_STEP;
     let out = json!({
         "sampler": a.sampler, "integrand": f.spec(), "n": a.n, "sets": a.sets, "seed": a.seed,
-        "shear": found.shear, "analytic_shear": analytic,
-        "estimator": "unshifted: Î = mean of f over the (sheared) set; unbiased for sheared umj",
-        "variance_before": {"variance": before.variance, "ci_low": before.ci_low, "ci_high": before.ci_high, "realizations": before.realizations},
-        "variance_after": {"variance": after.variance, "ci_low": after.ci_low, "ci_high": after.ci_high, "realizations": after.realizations},
-        "reduction": before.variance / after.variance,
-        "objective": {"unsheared": found.objective_unsheared, "optimum": found.objective, "evaluations": found.evaluations, "support": support},
+        "shear": found.shear, "initial_shear": found.initial.0, "analytic_shear": analytic,
+        "double_wedge": spectral.double_wedge, "kept_unsheared": found.kept_unsheared,
+        "spectrum": {"xu": plane(&spectral.planes[0]), "yv": plane(&spectral.planes[1])},
+        "estimator": "(x,y)-shifted: mean of f(x'+sx, y'+sy, u, v) over the sheared set, s uniform in (x,y); unbiased for any shear",
+        "objective": {
+            "description": "expected variance of the estimator over the sampler's randomness (closed form where the halves have one)",
+            "unsheared": found.unsheared.value, "initial": found.initial.1, "optimum": found.optimum.value,
+            "stderr": relative_stderr, "truncation_bound": objective.truncation_bound() / found.optimum.value,
+            "evaluations": found.evaluations, "terms": objective.terms(), "half": objective.half(),
+            "realizations": objective.realizations(),
+        },
+        "sensitivity": {"step": d, "a_minus": found.sensitivity[0], "a_plus": found.sensitivity[1],
+                        "b_minus": found.sensitivity[2], "b_plus": found.sensitivity[3]},
+        "variance_before": check.as_ref().map(|c| ci(&c.0)),
+        "variance_after": check.as_ref().map(|c| ci(&c.1)),
+        "reduction": found.unsheared.value / found.optimum.value,
         "seconds": search_seconds,
     });
     if a.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
+        let ratio = found.optimum.value / found.unsheared.value;
         println!(
-            "shear a = {:.4}, b = {:.4} (analytic {}); unshifted variance {:.4e} -> {:.4e} ({:.2}x lower), search {search_seconds:.2} s",
+            "shear a = {:.4}, b = {:.4} (spectral start {:.4}, {:.4}{}); expected variance {:.4e} -> {:.4e} ({}), search {search_seconds:.2} s",
             found.shear[0],
             found.shear[1],
-            analytic.map_or("n/a".into(), |v| format!("{:.3}, {:.3}", v[0], v[1])),
-            before.variance,
-            after.variance,
-            before.variance / after.variance
+            found.initial.0[0],
+            found.initial.0[1],
+            if spectral.double_wedge {
+                "; double wedge"
+            } else {
+                ""
+            },
+            found.unsheared.value,
+            found.optimum.value,
+            if ratio <= 1.0 {
+                format!("{:.2}x lower", 1.0 / ratio)
+            } else {
+                format!("{ratio:.2}x higher")
+            }
         );
+        if let Some((before, after)) = &check {
+            println!(
+                "check on {} fresh sets: {:.4e} [{:.4e}, {:.4e}] -> {:.4e} [{:.4e}, {:.4e}]",
+                after.realizations,
+                before.variance,
+                before.ci_low,
+                before.ci_high,
+                after.variance,
+                after.ci_low,
+                after.ci_high
+            );
+        }
     }
     Ok(())
 }

@@ -9,7 +9,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::{Disk, Gaussian, Integrand, IntegrandClass, Rect, sinc_pi};
+use super::{Disk, Gaussian, Integrand, IntegrandClass, LightField, PlaneWave, Rect, sinc_pi};
 use crate::points::wrap01;
 
 /// The 2D shape g of a defocus light field.
@@ -50,6 +50,41 @@ impl Defocus {
     /// The shear c.
     pub fn shear(&self) -> f64 {
         self.c
+    }
+
+    /// The shape's size (box side, disk diameter, Gaussian 4σ).
+    pub fn size(&self) -> f64 {
+        self.size
+    }
+
+    /// The shape's name in specs.
+    pub(super) fn shape_name(&self) -> &'static str {
+        match self.shape {
+            DefocusShape::Box => "box",
+            DefocusShape::Disk => "disk",
+            DefocusShape::Gaussian => "gaussian",
+        }
+    }
+
+    /// The 2D shape g.
+    pub(super) fn shape(&self) -> &dyn Integrand {
+        self.g.as_ref()
+    }
+}
+
+/// φ_k(u, v) = G(k)·e^(2πi c k·((u,v) − ½)): one plane wave of frequency c·k.
+impl LightField for Defocus {
+    fn plane_waves(&self, k: [i64; 2], out: &mut Vec<PlaneWave>) {
+        let c = self.c;
+        out.push(PlaneWave {
+            amplitude: self.g.fourier(&k)
+                * crate::spectrum::pair::turn(-0.5 * c * (k[0] + k[1]) as f64),
+            frequency: [c * k[0] as f64, c * k[1] as f64],
+        });
+    }
+
+    fn layer_shears(&self) -> Vec<[f64; 2]> {
+        vec![[-self.c, -self.c]]
     }
 }
 
@@ -96,11 +131,15 @@ impl Integrand for Defocus {
     }
 
     fn spec(&self) -> String {
-        let shape = match self.shape {
-            DefocusShape::Box => "box",
-            DefocusShape::Disk => "disk",
-            DefocusShape::Gaussian => "gaussian",
-        };
-        format!("defocus:shape={shape},size={},c={}", self.size, self.c)
+        format!(
+            "defocus:shape={},size={},c={}",
+            self.shape_name(),
+            self.size,
+            self.c
+        )
+    }
+
+    fn light_field(&self) -> Option<&dyn LightField> {
+        Some(self)
     }
 }

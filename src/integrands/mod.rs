@@ -12,6 +12,8 @@ mod defocus;
 mod disk;
 mod gaussian;
 mod halfplane;
+mod layers;
+mod light_field;
 mod rect;
 mod spec;
 
@@ -20,6 +22,8 @@ pub use defocus::{Defocus, DefocusShape};
 pub use disk::Disk;
 pub use gaussian::Gaussian;
 pub use halfplane::HalfPlane;
+pub use layers::Layers;
+pub use light_field::{LightField, PlaneWave, energy as light_field_energy};
 pub use rect::Rect;
 pub use spec::{INTEGRANDS, IntegrandInfo, parse};
 
@@ -51,6 +55,11 @@ pub trait Integrand: Send + Sync {
     fn class(&self) -> IntegrandClass;
     /// The canonical spec string, e.g. `disk:r=0.3,cx=0.5,cy=0.5`.
     fn spec(&self) -> String;
+    /// The light-field form of a 4D integrand ([`LightField`]), if it has
+    /// one: what the shear search evaluates exactly.
+    fn light_field(&self) -> Option<&dyn LightField> {
+        None
+    }
 }
 
 /// What the convergence theory needs to know of an integrand

@@ -2,7 +2,8 @@
 //! `varspec integrands --list` prints.
 
 use super::{
-    Cosine, Defocus, DefocusShape, Disk, Gaussian, HalfPlane, Integrand, IntegrandError, Rect,
+    Cosine, Defocus, DefocusShape, Disk, Gaussian, HalfPlane, Integrand, IntegrandError, Layers,
+    Rect,
 };
 
 /// A registered integrand.
@@ -97,6 +98,18 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
             ("c", "0", "shear c = (F − d)/d"),
         ],
     },
+    IntegrandInfo {
+        name: "layers",
+        dim: 4,
+        summary: "two defocus layers (1 − mix)·g sheared by c1 + mix·g sheared by c2: a double wedge",
+        params: &[
+            ("shape", "box", "g: box, disk or gaussian, as for defocus"),
+            ("size", "0.3", "see defocus, in (0, 1]"),
+            ("c1", "0.5", "shear of the first layer"),
+            ("c2", "-0.2", "shear of the second layer, |c2 − c1| ≥ 0.05"),
+            ("mix", "0.5", "weight of the second layer, in [0, 1]"),
+        ],
+    },
 ];
 
 /// Key-value parameters of one spec, checked against the registry.
@@ -149,6 +162,15 @@ impl Params {
             .ok()
             .filter(|v| v.abs() <= 1 << 40)
             .ok_or_else(|| self.bad(key, "an integer (the integrand must be periodic)"))
+    }
+
+    fn shape(&self) -> Result<DefocusShape, IntegrandError> {
+        match self.text("shape") {
+            "box" => Ok(DefocusShape::Box),
+            "disk" => Ok(DefocusShape::Disk),
+            "gaussian" => Ok(DefocusShape::Gaussian),
+            _ => Err(self.bad("shape", "box, disk or gaussian")),
+        }
     }
 
     fn centre(&self) -> Result<[f64; 2], IntegrandError> {
@@ -244,18 +266,23 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
             p.number("angle", |_| true, "an angle in degrees")?,
             p.number("offset", |o| o.abs() <= 1.0, "an offset in [-1, 1]")?,
         )),
-        "defocus" => {
-            let shape = match p.text("shape") {
-                "box" => DefocusShape::Box,
-                "disk" => DefocusShape::Disk,
-                "gaussian" => DefocusShape::Gaussian,
-                _ => return Err(p.bad("shape", "box, disk or gaussian")),
-            };
-            let size = p.number("size", unit, "a size in (0, 1]")?;
-            Box::new(Defocus::new(
-                shape,
-                size,
-                p.number("c", |c| c.abs() <= 16.0, "a shear in [-16, 16]")?,
+        "defocus" => Box::new(Defocus::new(
+            p.shape()?,
+            p.number("size", unit, "a size in (0, 1]")?,
+            p.number("c", |c| c.abs() <= 16.0, "a shear in [-16, 16]")?,
+        )),
+        "layers" => {
+            let shear = |key| p.number(key, |c: f64| c.abs() <= 16.0, "a shear in [-16, 16]");
+            let (c1, c2) = (shear("c1")?, shear("c2")?);
+            if (c2 - c1).abs() < 0.05 {
+                return Err(p.bad("c2", "a shear at least 0.05 from c1 (else use defocus)"));
+            }
+            Box::new(Layers::new(
+                p.shape()?,
+                p.number("size", unit, "a size in (0, 1]")?,
+                c1,
+                c2,
+                p.number("mix", |m| (0.0..=1.0).contains(&m), "a weight in [0, 1]")?,
             ))
         }
         _ => unreachable!("every registered integrand is built above"),

@@ -1,0 +1,572 @@
+//! The expected variance of a sheared padded 4D set, in closed form.
+//!
+//! A padded sampler draws an (x, y) set P and a (u, v) set Q independently
+//! and pairs them by a uniformly random permutation π. Shear it,
+//! x′_j = x_j + a·u_π(j), y′_j = y_j + b·v_π(j), and judge it by the
+//! estimator Î(s) = (1/N) Σ_j f(x′_j + s_x, y′_j + s_y, u_π(j), v_π(j))
+//! with a uniform shift s in (x, y) only: a shift in (u, v) would wrap
+//! across the shear and undo it, and the (x, y) shift keeps Î unbiased for
+//! any light field (docs/mathematics.md §6.2).
+//!
+//! Write f in (x, y) Fourier series, f = Σ_k φ_k(u, v) e^(2πik·(x,y)), with
+//! φ_k = Σ_t A_t(k) e^(2πi ω_t(k)·(u,v)) ([`LightField`]). Averaging over s
+//! leaves Σ_(k≠0) |(1/N) Σ_j φ_k(q_π(j)) e^(2πik·x′_j)|², and averaging over
+//! the random pairing separates the pairs of P from the pairs of Q. With
+//! E[N·P_P(k)] = p_k the (x, y) half's expected power and
+//! C(ω, ω′) = E[Σ_(l≠m) e^(2πi(ω·q_l − ω′·q_m))] the (u, v) half's expected
+//! pair sum ([`PairSpectrum`]):
+//!
+//!   J(a, b) = Var f / N
+//!           + Σ_(k≠0) (p_k − 1)/(N²(N − 1)) · Σ_(t,t′) A_t conj(A_t′) C(ω_t + σ_k, ω_t′ + σ_k),
+//!
+//! σ_k = (a·k_x, b·k_y). The first term is plain random sampling; the
+//! second is what the two halves' correlations buy. Where both halves have
+//! closed forms (random, jitter, multi-jitter, CMJ) J is exact up to the
+//! truncation of the sum, which is reported as a bound; other halves are
+//! estimated from realizations with a standard error.
+//!
+//! At the shear a = b = −c of a single defocus layer, σ_k cancels ω(k) = c·k,
+//! C(0, 0) = N(N − 1) and J = Σ_k |G(k)|² p_k / N: the (x, y) set integrates
+//! the 2D shape g alone, which is why the light field's own shear is the
+//! optimum wherever p_k < 1.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use rayon::prelude::*;
+
+use super::super::OptimizeError;
+use crate::integrands::{Integrand, LightField, PlaneWave, light_field_energy};
+use crate::rng::set_rng;
+use crate::samplers::Sampler;
+use crate::spectrum::pair::{EmpiricalPairs, PairSpectrum};
+use crate::spectrum::{FrequencyBox, Method, expected_power_with};
+use crate::variance::sum::NeumaierSum;
+
+/// Terms summed per parallel task: fixed, so the sum's rounding is the
+/// same for any number of threads.
+const CHUNK: usize = 32;
+/// Largest box half-width of the frequency sum.
+const MAX_HALF: usize = 1024;
+/// Box half-width when the (x, y) half is estimated from realizations.
+const EMPIRICAL_HALF: usize = 48;
+/// Stream offsets of the realizations behind empirical halves.
+const XY_STREAM: u64 = 0x5859_5f48_414c_4631;
+const UV_STREAM: u64 = 0x5556_5f48_414c_4632;
+
+/// How accurate the objective must be.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObjectiveOptions {
+    /// Target of truncation bound / J at the start (relative).
+    pub truncation: f64,
+    /// Target relative standard error at the start, for halves estimated
+    /// from realizations.
+    pub stderr: f64,
+    /// Realizations of an estimated half: the first try.
+    pub min_realizations: usize,
+    /// Realizations of an estimated half: the most.
+    pub max_realizations: usize,
+    /// Seed of those realizations.
+    pub seed: u64,
+}
+
+impl Default for ObjectiveOptions {
+    fn default() -> Self {
+        ObjectiveOptions {
+            truncation: 0.01,
+            stderr: 0.01,
+            min_realizations: 64,
+            max_realizations: 4096,
+            seed: 0,
+        }
+    }
+}
+
+/// One frequency k of the half-plane (it stands for k and −k).
+struct Term {
+    waves: Vec<PlaneWave>,
+    k: [f64; 2],
+    /// (p_k − 1)·2/(N²(N − 1)).
+    coefficient: f64,
+    /// Index into the (x, y) spectrum box, for per-set statistics.
+    box_index: Option<usize>,
+}
+
+/// The (x, y) half's expected power.
+enum XyPower {
+    Exact,
+    /// Mean over `sets` realizations on a box.
+    Empirical {
+        freqs: FrequencyBox,
+        power: Vec<f64>,
+        sets: usize,
+    },
+}
+
+/// The (u, v) half's expected pair sums.
+enum UvPairs<'a> {
+    Exact(&'a dyn PairSpectrum),
+    Empirical(EmpiricalPairs),
+}
+
+impl UvPairs<'_> {
+    fn spectrum(&self) -> &dyn PairSpectrum {
+        match self {
+            UvPairs::Exact(s) => *s,
+            UvPairs::Empirical(e) => e,
+        }
+    }
+}
+
+/// The objective J(a, b): the expected variance of the (x, y)-shifted
+/// estimator over the sampler's randomness.
+pub struct ShearObjective<'a> {
+    n: usize,
+    variance: f64,
+    sampler: &'a dyn Sampler,
+    xy: XyPower,
+    uv: UvPairs<'a>,
+    terms: Vec<Term>,
+    half: usize,
+    truncation_bound: f64,
+    seed: u64,
+    evaluations: AtomicU64,
+}
+
+/// J at one shear with its uncertainty.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evaluation {
+    /// J(a, b).
+    pub value: f64,
+    /// Standard error from the estimated halves (0 when both are exact).
+    pub stderr: f64,
+}
+
+impl<'a> ShearObjective<'a> {
+    /// The objective for light field `f` and padded sampler `sampler`,
+    /// accurate to `options` at the shears `starts` (the best of them sets
+    /// the scale of the targets).
+    ///
+    /// # Errors
+    /// [`OptimizeError::Option`] when `f` has no light-field form or the
+    /// sampler has no (x, y) and (u, v) halves; sampler errors of estimated
+    /// halves.
+    pub fn new(
+        f: &dyn Integrand,
+        sampler: &'a dyn Sampler,
+        starts: &[[f64; 2]],
+        options: ObjectiveOptions,
+    ) -> Result<Self, OptimizeError> {
+        let light = f.light_field().ok_or_else(|| {
+            OptimizeError::Option(format!(
+                "the shear search evaluates the expected variance from a light field's spectrum; \
+                 {} has no light-field form (4D light fields: defocus, layers)",
+                f.spec()
+            ))
+        })?;
+        let [xy_half, uv_half] = sampler.halves().ok_or_else(|| {
+            OptimizeError::Option(
+                "the shear search needs a padded 4D sampler with independent (x, y) and (u, v) \
+                 halves: umj or padded:xy=...,uv=..."
+                    .into(),
+            )
+        })?;
+        let n = sampler.points_per_set();
+        if n < 2 {
+            return Err(OptimizeError::Option(
+                "the shear search needs at least 2 points per set".into(),
+            ));
+        }
+        let mut realizations = options.min_realizations.max(2);
+        loop {
+            let uv = match uv_half.pair_spectrum() {
+                Some(s) => UvPairs::Exact(s),
+                None => UvPairs::Empirical(EmpiricalPairs::new(draw(
+                    uv_half,
+                    options.seed ^ UV_STREAM,
+                    realizations,
+                )?)),
+            };
+            let xy = match xy_half.pair_spectrum() {
+                Some(_) => XyPower::Exact,
+                None => {
+                    let freqs = FrequencyBox {
+                        dim: 2,
+                        half: EMPIRICAL_HALF,
+                    };
+                    let seed = options.seed ^ XY_STREAM;
+                    let (spectrum, _) = expected_power_with(
+                        freqs,
+                        Method::Fast { tolerance: 1e-10 },
+                        realizations,
+                        |r| {
+                            xy_half
+                                .sample(&mut set_rng(seed, r as u64))
+                                .map_err(OptimizeError::from)
+                        },
+                        &|_| 0.0,
+                        &|| {},
+                    )?;
+                    XyPower::Empirical {
+                        freqs,
+                        power: spectrum.power,
+                        sets: realizations,
+                    }
+                }
+            };
+            let mut objective = ShearObjective {
+                n,
+                variance: f.variance(),
+                sampler,
+                xy,
+                uv,
+                terms: Vec::new(),
+                half: 0,
+                truncation_bound: 0.0,
+                seed: options.seed,
+                evaluations: 0.into(),
+            };
+            objective.choose_terms(light, xy_half, starts, options.truncation)?;
+            let best = starts
+                .iter()
+                .map(|&s| objective.value(s[0], s[1]))
+                .fold(f64::INFINITY, f64::min);
+            let at = starts
+                .iter()
+                .copied()
+                .find(|s| objective.value(s[0], s[1]) == best)
+                .unwrap_or([0.0, 0.0]);
+            let relative = objective.evaluate(at)?.stderr / best.abs().max(f64::MIN_POSITIVE);
+            if relative <= options.stderr || realizations >= options.max_realizations {
+                objective.evaluations.store(0, Ordering::Relaxed);
+                return Ok(objective);
+            }
+            let factor = (relative / options.stderr).powi(2).ceil() as usize;
+            realizations = (realizations * factor.max(2)).min(options.max_realizations);
+        }
+    }
+
+    /// The frequency terms, chosen to keep the truncation bound within
+    /// `target` of J at the starts (J_ref, computed on the box |k|∞ ≤ 64
+    /// first):
+    /// 1. the box |k|∞ ≤ h, h doubled from 64 until the Parseval tail
+    ///    beyond it, (Var f − Σ_box ∫|φ_k|²)·L/(N − 1) for L plane waves and
+    ///    |p − 1| ≤ 1 beyond the box, is at most 2/3 of the budget, and for
+    ///    exact (x, y) halves the axes out to 4N (stratified samplers keep
+    ///    their 1D structure there, p ≈ 0 far out);
+    /// 2. the terms with the smallest bounds |p − 1|·(Σ_t|A_t|)²·2/(N − 1)
+    ///    dropped while their sum stays within the remaining third.
+    fn choose_terms(
+        &mut self,
+        light: &dyn LightField,
+        xy_half: &dyn Sampler,
+        starts: &[[f64; 2]],
+        target: f64,
+    ) -> Result<(), OptimizeError> {
+        let n = self.n as f64;
+        let exact_xy = xy_half.pair_spectrum();
+        let axes = |h: usize| exact_xy.map(|_| (4 * self.n).max(h));
+        let first_half = match self.xy {
+            XyPower::Exact => 64,
+            XyPower::Empirical { freqs, .. } => freqs.half,
+        };
+        self.terms = self.make_terms(light, exact_xy, &half_plane(first_half, axes(first_half)));
+        self.half = first_half;
+        let reference = starts
+            .iter()
+            .map(|&s| self.value(s[0], s[1]))
+            .fold(f64::INFINITY, f64::min)
+            .max(f64::MIN_POSITIVE);
+        let budget = target * reference;
+        let mut waves_per_k = 1.0f64;
+        let mut half = first_half;
+        let tail = loop {
+            let frequencies = half_plane(half, axes(half));
+            let (energy, waves) = frequencies
+                .par_iter()
+                .map_init(Vec::new, |buffer, &k| {
+                    buffer.clear();
+                    light.plane_waves(k, buffer);
+                    (2.0 * light_field_energy(buffer), buffer.len())
+                })
+                .fold(
+                    || (NeumaierSum::default(), 0usize),
+                    |(mut s, w), (e, l)| {
+                        s.add(e);
+                        (s, w.max(l))
+                    },
+                )
+                .collect::<Vec<_>>()
+                .into_iter()
+                .fold((NeumaierSum::default(), 0usize), |(mut s, w), (t, l)| {
+                    s.merge(t);
+                    (s, w.max(l))
+                });
+            waves_per_k = waves_per_k.max(waves as f64);
+            let tail = (self.variance - energy.value()).max(0.0) * waves_per_k / (n - 1.0);
+            let grow = matches!(self.xy, XyPower::Exact) && 2 * half <= MAX_HALF;
+            if tail > (2.0 / 3.0) * budget && grow {
+                half *= 2;
+            } else {
+                break tail;
+            }
+        };
+        let frequencies = half_plane(half, axes(half));
+        // Bounds of every candidate, then the smallest dropped within budget.
+        let bounds: Vec<f64> = frequencies
+            .par_iter()
+            .map_init(Vec::new, |buffer, &k| {
+                buffer.clear();
+                light.plane_waves(k, buffer);
+                let p = self.xy_power(exact_xy, k);
+                let amplitude: f64 = buffer.iter().map(|w| w.amplitude.norm()).sum();
+                (p - 1.0).abs() * amplitude * amplitude * 2.0 / (n - 1.0)
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..frequencies.len()).collect();
+        order.sort_by(|&i, &j| bounds[i].total_cmp(&bounds[j]).then(i.cmp(&j)));
+        // At the largest box the tail may exceed its share: the dropped
+        // terms still get a third of the budget.
+        let allowance = (budget - tail).max(budget / 3.0);
+        let mut dropped = 0.0;
+        let mut keep = vec![true; frequencies.len()];
+        for &i in &order {
+            if dropped + bounds[i] > allowance {
+                break;
+            }
+            dropped += bounds[i];
+            keep[i] = false;
+        }
+        let kept: Vec<[i64; 2]> = frequencies
+            .iter()
+            .zip(&keep)
+            .filter(|(_, k)| **k)
+            .map(|(f, _)| *f)
+            .collect();
+        self.terms = self.make_terms(light, exact_xy, &kept);
+        self.half = half;
+        self.truncation_bound = tail + dropped;
+        Ok(())
+    }
+
+    /// E[N·P_S(k)] of the (x, y) half.
+    fn xy_power(&self, exact: Option<&dyn PairSpectrum>, k: [i64; 2]) -> f64 {
+        match (&self.xy, exact) {
+            (XyPower::Exact, Some(s)) => s.power([k[0] as f64, k[1] as f64]),
+            (XyPower::Empirical { freqs, power, .. }, _) => power[box_index(freqs, k)],
+            (XyPower::Exact, None) => unreachable!("exact halves have a closed form"),
+        }
+    }
+
+    /// The terms of the frequencies `ks`.
+    fn make_terms(
+        &self,
+        light: &dyn LightField,
+        exact: Option<&dyn PairSpectrum>,
+        ks: &[[i64; 2]],
+    ) -> Vec<Term> {
+        let n = self.n as f64;
+        let scale = 2.0 / (n * n * (n - 1.0));
+        ks.par_iter()
+            .map(|&k| {
+                let mut waves = Vec::new();
+                light.plane_waves(k, &mut waves);
+                let box_index = match &self.xy {
+                    XyPower::Empirical { freqs, .. } => Some(box_index(freqs, k)),
+                    XyPower::Exact => None,
+                };
+                Term {
+                    waves,
+                    k: [k[0] as f64, k[1] as f64],
+                    coefficient: (self.xy_power(exact, k) - 1.0) * scale,
+                    box_index,
+                }
+            })
+            .collect()
+    }
+
+    /// J(a, b).
+    pub fn value(&self, a: f64, b: f64) -> f64 {
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let partial: Vec<NeumaierSum> = self
+            .terms
+            .par_chunks(CHUNK)
+            .map(|chunk| {
+                let uv = self.uv.spectrum();
+                let mut s = NeumaierSum::default();
+                for t in chunk {
+                    s.add(t.coefficient * uv.wave_pair_sum(&t.waves, [a * t.k[0], b * t.k[1]]));
+                }
+                s
+            })
+            .collect();
+        let mut total = NeumaierSum::default();
+        total.add(self.variance / self.n as f64);
+        for p in partial {
+            total.merge(p);
+        }
+        total.value()
+    }
+
+    /// J at `shear` with its standard error: for an estimated half, the
+    /// spread of J over its realizations (the other half at its mean), the
+    /// two halves' variances added.
+    ///
+    /// # Errors
+    /// Sampler errors while redrawing an estimated (x, y) half.
+    pub fn evaluate(&self, [a, b]: [f64; 2]) -> Result<Evaluation, OptimizeError> {
+        let value = self.value(a, b);
+        let base = self.variance / self.n as f64;
+        let mut variance = 0.0;
+        if let UvPairs::Empirical(sets) = &self.uv {
+            let per_set: Vec<f64> = (0..sets.sets())
+                .into_par_iter()
+                .map(|r| {
+                    let mut s = NeumaierSum::default();
+                    s.add(base);
+                    for t in &self.terms {
+                        s.add(
+                            t.coefficient
+                                * sets.wave_pair_sum_of(r, &t.waves, [a * t.k[0], b * t.k[1]]),
+                        );
+                    }
+                    s.value()
+                })
+                .collect();
+            variance += sample_variance(&per_set) / per_set.len() as f64;
+        }
+        if let XyPower::Empirical { freqs, sets, .. } = &self.xy {
+            let n = self.n as f64;
+            let scale = 2.0 / (n * n * (n - 1.0));
+            let uv_part: Vec<(usize, f64)> = self
+                .terms
+                .iter()
+                .map(|t| {
+                    let index = t.box_index.expect("empirical terms index the box");
+                    (
+                        index,
+                        scale
+                            * self
+                                .uv
+                                .spectrum()
+                                .wave_pair_sum(&t.waves, [a * t.k[0], b * t.k[1]]),
+                    )
+                })
+                .collect();
+            let seed = self.seed ^ XY_STREAM;
+            let [xy_half, _] = self.sampler.halves().expect("checked at construction");
+            let statistic = |power: &[f64]| {
+                let mut s = NeumaierSum::default();
+                s.add(base);
+                for &(i, x) in &uv_part {
+                    s.add((power[i] - 1.0) * x);
+                }
+                s.value()
+            };
+            let (_, per_set) = expected_power_with(
+                *freqs,
+                Method::Fast { tolerance: 1e-10 },
+                *sets,
+                |r| {
+                    xy_half
+                        .sample(&mut set_rng(seed, r as u64))
+                        .map_err(OptimizeError::from)
+                },
+                &statistic,
+                &|| {},
+            )?;
+            variance += sample_variance(&per_set) / per_set.len() as f64;
+        }
+        Ok(Evaluation {
+            value,
+            stderr: variance.sqrt(),
+        })
+    }
+
+    /// Bound on the error of J from the frequencies left out (assuming
+    /// |E[N·P_S] − 1| ≤ 1 beyond the box for the (x, y) half).
+    pub fn truncation_bound(&self) -> f64 {
+        self.truncation_bound
+    }
+
+    /// Frequencies k (of the half-plane, each standing for ±k) in the sum.
+    pub fn terms(&self) -> usize {
+        self.terms.len()
+    }
+
+    /// Box half-width h of the sum.
+    pub fn half(&self) -> usize {
+        self.half
+    }
+
+    /// Realizations behind each estimated half (0 when exact): (x, y), (u, v).
+    pub fn realizations(&self) -> [usize; 2] {
+        let xy = match &self.xy {
+            XyPower::Exact => 0,
+            XyPower::Empirical { sets, .. } => *sets,
+        };
+        let uv = match &self.uv {
+            UvPairs::Exact(_) => 0,
+            UvPairs::Empirical(e) => e.sets(),
+        };
+        [xy, uv]
+    }
+
+    /// Evaluations of J so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations.load(Ordering::Relaxed)
+    }
+}
+
+/// Frequencies of the half-plane (k_x > 0, or k_x = 0 and k_y > 0) in the
+/// box |k|∞ ≤ `half`, plus the axes out to `axes` when given.
+fn half_plane(half: usize, axes: Option<usize>) -> Vec<[i64; 2]> {
+    let h = half as i64;
+    let mut out = Vec::with_capacity((2 * half + 1) * (half + 1));
+    for kx in 0..=h {
+        for ky in -h..=h {
+            if kx > 0 || ky > 0 {
+                out.push([kx, ky]);
+            }
+        }
+    }
+    if let Some(axes) = axes {
+        for k in h + 1..=axes as i64 {
+            out.push([k, 0]);
+            out.push([0, k]);
+        }
+    }
+    out
+}
+
+/// Index of k in a 2D box (k_x fastest).
+fn box_index(freqs: &FrequencyBox, k: [i64; 2]) -> usize {
+    let side = freqs.side() as i64;
+    let h = freqs.half as i64;
+    ((k[1] + h) * side + k[0] + h) as usize
+}
+
+/// Realizations 0..count of `sampler` from `seed`.
+fn draw(
+    sampler: &dyn Sampler,
+    seed: u64,
+    count: usize,
+) -> Result<Vec<crate::points::PointSet>, OptimizeError> {
+    (0..count as u64)
+        .into_par_iter()
+        .map(|r| {
+            sampler
+                .sample(&mut set_rng(seed, r))
+                .map_err(OptimizeError::from)
+        })
+        .collect()
+}
+
+/// Unbiased sample variance (two passes).
+fn sample_variance(values: &[f64]) -> f64 {
+    if values.len() < 2 {
+        return 0.0;
+    }
+    let mean = crate::variance::sum::sum(values.iter().copied()) / values.len() as f64;
+    crate::variance::sum::sum(values.iter().map(|v| (v - mean) * (v - mean)))
+        / (values.len() - 1) as f64
+}

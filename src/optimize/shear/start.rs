@@ -1,0 +1,238 @@
+//! Where the shear search starts: read off the integrand's spectrum, the
+//! way the seed reads a light field's shear (Singh & Jarosz 2017, §3;
+//! Soler et al. 2009). A layer at shear c puts its energy on the line
+//! k_u = c·k_x of the (k_x, k_u) plane (and k_v = c·k_y of (k_y, k_v)), and
+//! the shear that flattens it is a = −c.
+//!
+//! - **Principal direction**: the leading eigenvector (k_x, k_u) of the
+//!   energy's second-moment matrix M = Σ E(k)·k kᵀ over the plane's
+//!   frequencies, a symmetric 2×2 eigenproblem; its slope is c. Only the
+//!   strongest frequencies holding [`CORE`] of the plane's energy enter M,
+//!   so the sinc² side lobes a lens aperture spreads along k_u do not tilt
+//!   it.
+//! - **One sheared plane or two**: a single layer f = g(x + c(u − ½)) with
+//!   u on [0, 1) puts, in every column k_x, exactly the profile
+//!   sinc²(π(k_u − c·k_x)) times the column's energy. The misfit of that
+//!   one-line model, min over s of
+//!   Σ_(k_x≠0) Σ_(k_u) |E(k) − E_col(k_x)·sinc²(π(k_u − s·k_x))| / Σ E,
+//!   is near 0 for one layer (only the box edge truncates the profile) and
+//!   large when the energy splits between two directions: the seed's
+//!   double wedge, where no single shear fits both layers. Above
+//!   [`DOUBLE_WEDGE_MISFIT`] the spectrum is called a double wedge, and the
+//!   slope capturing most energy outside the first line's band
+//!   (|k_u − s·k_x| < 1) is the second layer.
+
+use nalgebra::{Matrix2, SymmetricEigen};
+
+use crate::integrands::Integrand;
+
+/// Share of a plane's energy (largest frequencies first) in the moment
+/// matrix.
+const CORE: f64 = 0.9;
+/// Misfit of the one-line model above which the spectrum is a double
+/// wedge (the misfit ranges over [0, 2]; tests/optimize_shear.rs measures
+/// single layers and two-layer mixtures on either side of it).
+const DOUBLE_WEDGE_MISFIT: f64 = 0.1;
+/// Slopes closer than this are one direction.
+const MIN_SEPARATION: f64 = 0.15;
+/// Slope resolution of the line scan.
+const SLOPE_STEP: f64 = 0.005;
+
+/// The spectrum's directions in one plane, (k_x, k_u) or (k_y, k_v).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlaneDirections {
+    /// Slope k_u/k_x of the principal eigenvector.
+    pub principal: f64,
+    /// Ratio of the smaller to the larger eigenvalue of M (0 for a line).
+    pub eigenvalue_ratio: f64,
+    /// Slopes of the lines holding the energy: one, or two for a double
+    /// wedge (strongest first).
+    pub lines: Vec<f64>,
+    /// Share of the energy within the first line's band.
+    pub first_line_share: f64,
+    /// Share within the second line's band, outside the first's.
+    pub second_line_share: f64,
+    /// Misfit of the best one-line model (0 for a single lens layer).
+    pub one_line_misfit: f64,
+}
+
+/// What the spectrum says about the shear.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpectralStart {
+    /// The (k_x, k_u) and (k_y, k_v) planes.
+    pub planes: [PlaneDirections; 2],
+    /// The initial shear (a, b) = −(principal slopes).
+    pub shear: [f64; 2],
+    /// Whether the energy splits between two directions in either plane.
+    pub double_wedge: bool,
+}
+
+impl SpectralStart {
+    /// Shears worth trying first: the principal one and each line's.
+    pub fn candidates(&self) -> Vec<[f64; 2]> {
+        let mut out = vec![self.shear];
+        let [x, y] = &self.planes;
+        for &sx in &x.lines {
+            for &sy in &y.lines {
+                out.push([-sx, -sy]);
+            }
+        }
+        out
+    }
+}
+
+/// Reads the directions of a 4D integrand's spectrum on the slices
+/// k_y = k_v = 0 and k_x = k_u = 0 of the box |k|∞ ≤ `half`, slopes
+/// limited to [−`range`, `range`].
+pub fn spectral_start(f: &dyn Integrand, half: i64, range: f64) -> SpectralStart {
+    let plane = |axis: usize| {
+        let side = (2 * half + 1) as usize;
+        let mut grid = vec![0.0; side * side];
+        for (i, k1) in (-half..=half).enumerate() {
+            for (j, k2) in (-half..=half).enumerate() {
+                if k1 == 0 && k2 == 0 {
+                    continue;
+                }
+                let mut k = [0i64; 4];
+                k[axis] = k1;
+                k[axis + 2] = k2;
+                grid[i * side + j] = f.fourier(&k).norm_sqr();
+            }
+        }
+        directions(&grid, half, range)
+    };
+    let planes = [plane(0), plane(1)];
+    let shear = [-planes[0].principal, -planes[1].principal];
+    let double_wedge = planes.iter().any(|p| p.lines.len() > 1);
+    SpectralStart {
+        planes,
+        shear,
+        double_wedge,
+    }
+}
+
+/// Principal direction and lines of one plane's energy E(k₁, k₂) on the
+/// box |k|∞ ≤ `half` (row k₁, column k₂; the origin holds 0).
+fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
+    let side = (2 * half + 1) as usize;
+    let mut energy: Vec<(f64, f64, f64)> = Vec::new();
+    for (i, k1) in (-half..=half).enumerate() {
+        for (j, k2) in (-half..=half).enumerate() {
+            let e = grid[i * side + j];
+            if e > 0.0 {
+                energy.push((k1 as f64, k2 as f64, e));
+            }
+        }
+    }
+    energy.sort_by(|a, b| b.2.total_cmp(&a.2));
+    let total: f64 = energy.iter().map(|e| e.2).sum();
+    let mut moments = Matrix2::zeros();
+    let mut kept = 0.0;
+    for &(k1, k2, e) in &energy {
+        if kept >= CORE * total {
+            break;
+        }
+        kept += e;
+        moments += Matrix2::new(k1 * k1, k1 * k2, k1 * k2, k2 * k2) * e;
+    }
+    let eigen = SymmetricEigen::new(moments);
+    let (big, small) = if eigen.eigenvalues[0] >= eigen.eigenvalues[1] {
+        (0, 1)
+    } else {
+        (1, 0)
+    };
+    let v = eigen.eigenvectors.column(big);
+    let principal = if v[0].abs() * range >= v[1].abs() {
+        v[1] / v[0]
+    } else {
+        range.copysign(v[1] * v[0])
+    };
+    let eigenvalue_ratio = if eigen.eigenvalues[big] > 0.0 {
+        (eigen.eigenvalues[small] / eigen.eigenvalues[big]).max(0.0)
+    } else {
+        0.0
+    };
+
+    // Columns k₁ ≠ 0 (on k₁ = 0 every slope passes through the same points).
+    let columns: Vec<(f64, &[f64], f64)> = (-half..=half)
+        .enumerate()
+        .filter(|&(_, k1)| k1 != 0)
+        .map(|(i, k1)| {
+            let column = &grid[i * side..(i + 1) * side];
+            (k1 as f64, column, column.iter().sum::<f64>())
+        })
+        .collect();
+    let off_total: f64 = columns.iter().map(|c| c.2).sum();
+    let steps = (range / SLOPE_STEP).round() as i64;
+    let slopes: Vec<f64> = (-steps..=steps).map(|i| i as f64 * SLOPE_STEP).collect();
+    if off_total <= 0.0 {
+        return PlaneDirections {
+            principal,
+            eigenvalue_ratio,
+            lines: vec![0.0],
+            first_line_share: 0.0,
+            second_line_share: 0.0,
+            one_line_misfit: 0.0,
+        };
+    }
+    let misfit = |s: f64| -> f64 {
+        let mut total = 0.0;
+        for &(k1, column, sum) in &columns {
+            for (j, &e) in column.iter().enumerate() {
+                let k2 = j as f64 - half as f64;
+                let model = sum * sinc2(k2 - s * k1);
+                total += (e - model).abs();
+            }
+        }
+        total / off_total
+    };
+    let in_band = |s: f64, k1: f64, k2: f64| (k2 - s * k1).abs() < 1.0;
+    let share = |s: f64, exclude: Option<f64>| -> f64 {
+        let mut captured = 0.0;
+        for &(k1, column, _) in &columns {
+            for (j, &e) in column.iter().enumerate() {
+                let k2 = j as f64 - half as f64;
+                if in_band(s, k1, k2) && exclude.is_none_or(|x| !in_band(x, k1, k2)) {
+                    captured += e;
+                }
+            }
+        }
+        captured / off_total
+    };
+    let (s1, one_line_misfit) =
+        slopes
+            .iter()
+            .map(|&s| (s, misfit(s)))
+            .fold(
+                (0.0, f64::INFINITY),
+                |acc, c| if c.1 < acc.1 { c } else { acc },
+            );
+    let first_line_share = share(s1, None);
+    let (s2, second_line_share) = slopes
+        .iter()
+        .filter(|&&s| (s - s1).abs() >= MIN_SEPARATION)
+        .map(|&s| (s, share(s, Some(s1))))
+        .fold((0.0, 0.0), |acc, c| if c.1 > acc.1 { c } else { acc });
+    let mut lines = vec![s1];
+    if one_line_misfit > DOUBLE_WEDGE_MISFIT {
+        lines.push(s2);
+    }
+    PlaneDirections {
+        principal,
+        eigenvalue_ratio,
+        lines,
+        first_line_share,
+        second_line_share,
+        one_line_misfit,
+    }
+}
+
+/// sinc²(πz), 1 at 0.
+fn sinc2(z: f64) -> f64 {
+    if z.abs() < 1e-8 {
+        return 1.0;
+    }
+    let r = z - 2.0 * (0.5 * z).round();
+    let s = (std::f64::consts::PI * r).sin() / (std::f64::consts::PI * z);
+    s * s
+}
