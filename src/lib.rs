@@ -35,11 +35,13 @@ pub mod io;
 pub mod neighbours;
 pub mod optimize;
 pub mod points;
+pub mod polygon;
 pub mod quadrature;
 pub mod report;
 pub mod rng;
 pub mod samplers;
 pub mod spectrum;
+pub mod square;
 pub mod variance;
 
 pub use error::Error;

@@ -181,6 +181,7 @@ fn f32_tables_stay_below_one() {
         dim: 2,
         sets: 1,
         layout: String::new(),
+        optimized_for: "none".into(),
         predicted_variance: vec![],
     };
     let mut bytes = Vec::new();

@@ -68,21 +68,34 @@ pub struct PointsArgs {
     /// Dimension (1 to 4).
     #[arg(short = 'd', long = "dim", default_value_t = 2)]
     dim: usize,
-    /// Target: an integrand spec (W = P_f), family:disks, power:A or radial:FILE.csv.
+    /// Where the points are used: on the torus under a random shift, or
+    /// on the unit square as they are (no shift).
+    #[arg(long, value_enum, default_value_t = DomainArg::Torus)]
+    domain: DomainArg,
+    /// Target. Torus: an integrand spec (W = P_f), family:disks, power:A or
+    /// radial:FILE.csv. Square: family MSEs and repulsion, e.g.
+    /// halfplanes+gaussians+16*blue (families: halfplanes, gaussians[:vmin=,vmax=]).
     #[arg(long)]
     target: String,
     /// Independent realizations, optimized in parallel.
     #[arg(long, default_value_t = 1)]
     sets: usize,
-    /// Maximum iterations per set.
-    #[arg(long, default_value_t = 1000)]
-    iters: usize,
+    /// Maximum iterations per set (default 1000 on the torus, 2000 on the square).
+    #[arg(long)]
+    iters: Option<usize>,
     /// Seed of the starting sets.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Sampler of the starting sets.
-    #[arg(long, default_value = "random")]
-    init: String,
+    /// Sampler of the starting sets (default random on the torus, jitter on the square).
+    #[arg(long)]
+    init: Option<String>,
+    /// Square: family members the result and the classic samplers are scored on.
+    #[arg(long, default_value_t = 1024)]
+    members: usize,
+    /// Square: seed of the scoring members (the descent draws its own members
+    /// from --seed on other streams).
+    #[arg(long, default_value_t = 1)]
+    score_seed: u64,
     /// Box half-width K of the loss (default: 2.5·N^(1/d) for families and
     /// power laws, 8·N^(1/d) within [32, 128] for integrands).
     #[arg(long)]
@@ -114,13 +127,24 @@ pub fn run(c: OptimizeCommand) -> anyhow::Result<()> {
     }
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum DomainArg {
+    Torus,
+    Square,
+}
+
 fn points(a: PointsArgs) -> anyhow::Result<()> {
     if a.sets == 0 {
         bail!("--sets must be at least 1");
     }
+    if a.domain == DomainArg::Square {
+        return points_square(a);
+    }
+    let init_name = a.init.clone().unwrap_or_else(|| "random".into());
+    let iters = a.iters.unwrap_or(1000);
     let target = Target::parse(&a.target)?;
     let mut options = DescentOptions::for_target(a.n, a.dim, &target);
-    options.iters = a.iters;
+    options.iters = iters;
     options.tolerance = a.tol;
     options.rel_tol = a.rel_tol;
     if let Some(h) = a.half {
@@ -128,8 +152,8 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     }
     let half = options.half;
     let optimizer = PointOptimizer::new(a.dim, &target, options)?;
-    let init = samplers::build(&a.init, a.n, Some(a.dim), &[])?;
-    let bar = progress::bar((a.sets * a.iters) as u64, "optimizing");
+    let init = samplers::build(&init_name, a.n, Some(a.dim), &[])?;
+    let bar = progress::bar((a.sets * iters) as u64, "optimizing");
     let start = Instant::now();
     let results = (0..a.sets)
         .into_par_iter()
@@ -229,10 +253,130 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     }
     if let Some(path) = &a.report {
         let report = json!({
-            "target": a.target, "n": a.n, "dim": a.dim, "sets": a.sets, "seed": a.seed, "init": a.init,
+            "target": a.target, "n": a.n, "dim": a.dim, "sets": a.sets, "seed": a.seed, "init": init_name, "domain": "torus",
             "half": half, "tolerance": a.tol, "seconds": seconds, "iterations": iterations,
             "loss": "sum over 0 < |k|inf <= half of W(k) P_S(k)  (for an integrand target: its predicted variance within the box)",
             "loss_curve": results[0].losses, "loss_curve_seconds": results[0].seconds, "comparison": comparison,
+        });
+        write_atomic(path, |w| {
+            w.write_all(serde_json::to_string_pretty(&report)?.as_bytes())
+        })?;
+    }
+    Ok(())
+}
+
+/// `optimize points --domain square`: descend on family MSEs of the
+/// unshifted estimator, then score the result and the classic samplers on
+/// family members the descent never saw.
+fn points_square(a: PointsArgs) -> anyhow::Result<()> {
+    use varspec::square::design::{closest_pair_ratio, default_options, design, parse_target};
+    use varspec::square::{Family, family_mse};
+
+    if a.dim != 2 {
+        bail!("the square holds 2D point sets (got -d {})", a.dim);
+    }
+    let terms = parse_target(&a.target)?;
+    let mut options = default_options();
+    if let Some(i) = a.iters {
+        options.iters = i;
+    }
+    let init_name = a.init.clone().unwrap_or_else(|| "jitter".into());
+    let (init, n) = samplers::build_nearest(&init_name, a.n, Some(2), &[])?;
+    if n != a.n {
+        bail!(
+            "--init {init_name} cannot start from N = {} (nearest: {n}); pick another --init or N",
+            a.n
+        );
+    }
+    let bar = progress::bar((a.sets * options.iters) as u64, "optimizing");
+    let start = Instant::now();
+    let results = (0..a.sets)
+        .into_par_iter()
+        .map(|r| -> anyhow::Result<_> {
+            let first = init.sample(&mut set_rng(a.seed, r as u64))?;
+            let seed = varspec::rng::mix64(a.seed ^ (r as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+            Ok(design(&terms, first, seed, &options, &|_, _| bar.inc(1)))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    let sets: Vec<_> = results.iter().map(|r| r.points.clone()).collect();
+    write_atomic(&a.output, |w| write_point_sets(w, &sets, PointFormat::Csv))?;
+    // Scores on members drawn with --score-seed.
+    let families = [Family::parse("halfplanes")?, Family::parse("gaussians")?];
+    let score = |sets: &[varspec::PointSet]| {
+        let mut m = serde_json::Map::new();
+        for f in &families {
+            let s = family_mse(sets, f, a.members, a.score_seed);
+            m.insert(
+                f.spec(),
+                json!({"mse": s.mse, "stderr": s.stderr, "members": s.members}),
+            );
+        }
+        let closest = sets
+            .iter()
+            .map(closest_pair_ratio)
+            .fold(f64::INFINITY, f64::min);
+        m.insert("closest_pair_over_hexagonal".into(), json!(closest));
+        m
+    };
+    let mut comparison = serde_json::Map::new();
+    comparison.insert("optimized".into(), json!(score(&sets)));
+    for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
+        if let Ok((s, n)) = samplers::build_nearest(name, a.n, Some(2), &[]) {
+            let classic: Vec<_> = (0..a.sets.max(8) as u64)
+                .map(|r| s.sample(&mut set_rng(a.seed ^ 0x5eed, r)))
+                .collect::<Result<_, _>>()?;
+            let mut m = score(&classic);
+            m.insert("n".into(), json!(n));
+            comparison.insert(name.into(), json!(m));
+        }
+    }
+    println!(
+        "{} set(s) of {} points designed on the square for {} in {seconds:.2} s (from {init_name}); \
+         unshifted estimator, scored on {} members per family (seed {})",
+        a.sets, a.n, a.target, a.members, a.score_seed
+    );
+    for (name, v) in &comparison {
+        print!("  {name:<14}");
+        for f in &families {
+            print!(
+                "  {} {:.3e}",
+                f.spec(),
+                v[f.spec()]["mse"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
+        println!(
+            "  closest pair {:.3}",
+            v["closest_pair_over_hexagonal"]
+                .as_f64()
+                .unwrap_or(f64::NAN)
+        );
+    }
+    if let Some(path) = &a.curve {
+        write_atomic(path, |w| {
+            writeln!(w, "iteration,seconds,loss")?;
+            for (i, (t, l)) in results[0]
+                .seconds
+                .iter()
+                .zip(&results[0].losses)
+                .enumerate()
+            {
+                writeln!(w, "{i},{t:?},{l:?}")?;
+            }
+            Ok(())
+        })?;
+    }
+    if let Some(path) = &a.report {
+        let report = json!({
+            "domain": "square", "estimator": "unshifted: mean of f over the set on [0,1)^2",
+            "target": a.target, "n": a.n, "sets": a.sets, "seed": a.seed, "init": init_name,
+            "iterations": options.iters, "seconds": seconds,
+            "loss": "sum of w_t MSE_t / MSE_t(start) (blue: repulsion / its value for uniform points); stochastic per iteration",
+            "score_start": results.iter().map(|r| r.start_score).collect::<Vec<_>>(),
+            "score_best": results.iter().map(|r| r.best_score).collect::<Vec<_>>(),
+            "loss_curve": results[0].losses, "loss_curve_seconds": results[0].seconds,
+            "comparison": comparison, "score_members": a.members, "score_seed": a.score_seed,
         });
         write_atomic(path, |w| {
             w.write_all(serde_json::to_string_pretty(&report)?.as_bytes())

@@ -54,6 +54,11 @@ pub enum Source {
 }
 
 impl SourceArgs {
+    /// The seed given with --seed.
+    pub fn seed(&self) -> u64 {
+        self.draw.seed
+    }
+
     /// Reads the file or builds the sampler; checks that the (projected)
     /// points are `dim`-dimensional (any dimension for `None`).
     pub fn resolve(&self, dim: Option<usize>) -> anyhow::Result<Source> {

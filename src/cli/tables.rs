@@ -72,6 +72,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (None, Some(path)) => (read_point_sets(path)?, path.display().to_string()),
         (None, None) => bail!("give --sampler or --from"),
     };
+    let optimized_for = match &a.sampler {
+        None => "unknown".to_string(),
+        Some(spec) => {
+            let (name, params) = samplers::split_spec(spec, &a.draw.params)?;
+            if samplers::find(name)?.name == "blue-noise" {
+                params
+                    .iter()
+                    .rev()
+                    .find(|(k, _)| k == "domain")
+                    .map_or_else(|| "torus".to_string(), |(_, v)| v.clone())
+            } else {
+                "none".to_string()
+            }
+        }
+    };
     let (n, dim) = (sets[0].len(), sets[0].dim());
     if sets.iter().any(|s| s.len() != n) {
         bail!("{source}: a table needs every set to have the same N");
@@ -111,6 +126,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         dim,
         sets: sets.len(),
         layout: format!("[set][point][dimension], {value_type}, values in [0, 1)"),
+        optimized_for,
         predicted_variance,
     };
     let name = a

@@ -12,6 +12,7 @@
 use rustfft::num_complex::Complex64;
 
 use super::{Integrand, IntegrandClass, sinc_pi};
+use crate::polygon::{clip, shoelace};
 use crate::spectrum::phase::exp_neg_2pi_i;
 
 /// Half-plane ∩ unit square indicator.
@@ -57,25 +58,6 @@ impl HalfPlane {
     }
 }
 
-/// The convex polygon `poly` (counter-clockwise) clipped to n·x ≥ level
-/// (one Sutherland–Hodgman pass).
-fn clip(poly: &[[f64; 2]], n: [f64; 2], level: f64) -> Vec<[f64; 2]> {
-    let side = |p: [f64; 2]| p[0] * n[0] + p[1] * n[1] - level;
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-        let (sa, sb) = (side(a), side(b));
-        if sa >= 0.0 {
-            out.push(a);
-        }
-        if (sa >= 0.0) != (sb >= 0.0) {
-            let t = sa / (sa - sb);
-            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
-        }
-    }
-    out
-}
-
 /// Area of the rectangle [x0, x0+w] × [y0, y0+h] where n·x ≥ level, in
 /// closed form: n·x over the rectangle is the sum of two uniform variables
 /// of widths p = |n_x|·w and q = |n_y|·h, whose distribution function is
@@ -100,17 +82,6 @@ fn rect_above(w: f64, h: f64, corner: [f64; 2], n: [f64; 2], level: f64) -> f64 
         1.0 - r * (r / p) / (2.0 * q)
     };
     w * h * (1.0 - below)
-}
-
-/// Area of a simple polygon (counter-clockwise positive).
-fn shoelace(poly: &[[f64; 2]]) -> f64 {
-    let n = poly.len();
-    0.5 * (0..n)
-        .map(|i| {
-            let (a, b) = (poly[i], poly[(i + 1) % n]);
-            a[0] * b[1] - a[1] * b[0]
-        })
-        .sum::<f64>()
 }
 
 impl Integrand for HalfPlane {

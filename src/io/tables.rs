@@ -56,6 +56,10 @@ pub struct TableMetadata {
     pub sets: usize,
     /// Layout and value type.
     pub layout: String,
+    /// The domain and estimator the sets were designed for: `torus` (the
+    /// shift-randomized estimator), `square` (the unshifted estimator on
+    /// [0,1)²), `none` (a classic sampler), or `unknown` (a converted file).
+    pub optimized_for: String,
     /// Predicted variance (shift-randomized estimator, spatial form, mean
     /// over the table's sets) on reference integrands.
     pub predicted_variance: Vec<(String, f64)>,

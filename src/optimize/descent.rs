@@ -9,17 +9,13 @@
 //! Σ_k c_d(k) e^(−2πik·x) is real and two of them travel as the real and
 //! imaginary parts of one transform. Cost O(N·w^d + K^d log K) per step.
 //!
-//! The step is Adam's (Kingma & Ba 2015, "Adam: a method for stochastic
-//! optimization", ICLR, Alg. 1) with a learning rate in units of the mean
-//! spacing N^(−1/d), decaying geometrically; a step that raises the loss
-//! above 1.5× the best so far is undone and the rate halved, so the descent
-//! cannot blow up. It stops when the loss improves by less than a relative
-//! `rel_tol` over 50 iterations, or after `iters`. Positions wrap modulo 1.
+//! The step is the shared Adam descent of [`super::adam`].
 
 use rustfft::num_complex::Complex64;
 
+use super::adam::{AdamOptions, DescentResult, Domain, PointObjective, adam};
 use super::{OptimizeError, Target};
-use crate::points::{PointSet, wrap01};
+use crate::points::PointSet;
 use crate::spectrum::nufft::NufftScratch;
 use crate::spectrum::{FrequencyBox, NufftPlan, Sign};
 
@@ -64,17 +60,6 @@ impl DescentOptions {
             final_step: 0.002,
         }
     }
-}
-
-/// The optimized set and how it got there.
-#[derive(Debug, Clone)]
-pub struct DescentResult {
-    /// The best set found.
-    pub points: PointSet,
-    /// Loss after each iteration (the first entry is the start's).
-    pub losses: Vec<f64>,
-    /// Wall time since the start at each entry of `losses`, in seconds.
-    pub seconds: Vec<f64>,
 }
 
 /// A designed descent: box, weights and NUFFT plan, reused for every
@@ -204,58 +189,43 @@ impl PointOptimizer {
         }
     }
 
-    /// Descends from `start`; `on_iteration(t, loss)` is called every step.
+    /// Descends from `start` by [`adam`] on the torus; `on_iteration(t,
+    /// loss)` is called every step.
     pub fn optimize(&self, start: PointSet, on_iteration: &dyn Fn(usize, f64)) -> DescentResult {
-        let (n, d) = (start.len(), start.dim());
         let o = &self.options;
-        let spacing = (1.0 / n.max(1) as f64).powf(1.0 / d as f64);
-        let (beta1, beta2, eps) = (0.9f64, 0.999f64, 1e-300f64);
-        let mut work = self.work(n);
-        let mut x = start.coords().to_vec();
-        let (mut m, mut v) = (vec![0.0; n * d], vec![0.0; n * d]);
-        let mut best = (f64::INFINITY, x.clone());
-        let mut losses = Vec::with_capacity(o.iters + 1);
-        let mut seconds = Vec::with_capacity(o.iters + 1);
-        let clock = std::time::Instant::now();
-        let mut damping = 1.0;
-        for t in 0..o.iters {
-            let points = PointSet::new(d, x.clone()).expect("wrapped coordinates lie in [0,1)");
-            let (loss, grad) = self.loss_and_gradient(&points, &mut work);
-            losses.push(loss);
-            seconds.push(clock.elapsed().as_secs_f64());
-            on_iteration(t, loss);
-            if loss < best.0 {
-                best = (loss, x.clone());
-            } else if loss > 1.5 * best.0 {
-                // Undo a step that blew up and take smaller ones from the best set.
-                x.clone_from(&best.1);
-                m.fill(0.0);
-                v.fill(0.0);
-                damping *= 0.5;
-                continue;
-            }
-            if t >= 50 && losses[t - 50] - loss < o.rel_tol * loss {
-                break;
-            }
-            let progress = t as f64 / o.iters as f64;
-            let lr = damping * spacing * o.step * (o.final_step / o.step).powf(progress);
-            let (c1, c2) = (
-                1.0 - beta1.powi(t as i32 + 1),
-                1.0 - beta2.powi(t as i32 + 1),
-            );
-            for i in 0..n * d {
-                m[i] = beta1 * m[i] + (1.0 - beta1) * grad[i];
-                v[i] = beta2 * v[i] + (1.0 - beta2) * grad[i] * grad[i];
-                let step = lr * (m[i] / c1) / ((v[i] / c2).sqrt() + eps);
-                x[i] = wrap01(x[i] - step);
-            }
-        }
-        let points = PointSet::new(d, best.1).expect("wrapped coordinates lie in [0,1)");
-        DescentResult {
-            points,
-            losses,
-            seconds,
-        }
+        let adam_options = AdamOptions {
+            iters: o.iters,
+            rel_tol: o.rel_tol,
+            step: o.step,
+            final_step: o.final_step,
+            score_every: 1,
+        };
+        let objective = TorusObjective {
+            optimizer: self,
+            work: std::sync::Mutex::new(self.work(start.len())),
+        };
+        adam(
+            start,
+            &objective,
+            &adam_options,
+            Domain::Torus,
+            on_iteration,
+        )
+    }
+}
+
+/// The spectral loss as a [`PointObjective`].
+struct TorusObjective<'a> {
+    optimizer: &'a PointOptimizer,
+    work: std::sync::Mutex<Work>,
+}
+
+impl PointObjective for TorusObjective<'_> {
+    fn loss_and_gradient(&self, points: &PointSet, _t: usize, gradient: &mut [f64]) -> f64 {
+        let mut work = self.work.lock().expect("one descent at a time");
+        let (loss, grad) = self.optimizer.loss_and_gradient(points, &mut work);
+        gradient.copy_from_slice(&grad);
+        loss
     }
 }
 

@@ -2,11 +2,14 @@
 //! minimize a weighted spectral loss ([`descent`], weights from
 //! [`target`]), and the shear search for structured 4D sets ([`shear`]).
 
+pub mod adam;
 pub mod descent;
+pub mod repulsion;
 pub mod shear;
 pub mod target;
 
-pub use descent::{DescentOptions, DescentResult, PointOptimizer};
+pub use adam::{AdamOptions, DescentResult, Domain, PointObjective, adam};
+pub use descent::{DescentOptions, PointOptimizer};
 pub use target::Target;
 
 /// What stops an optimization.

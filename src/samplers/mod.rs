@@ -25,7 +25,9 @@ pub use nrooks::NRooks;
 pub use padded::Padded;
 pub use poisson_disk::{PoissonDisk, packing_radius};
 pub use random::Random;
-pub use registry::{DimRange, ParamInfo, SAMPLERS, SamplerInfo, build, build_nearest, find};
+pub use registry::{
+    DimRange, ParamInfo, SAMPLERS, SamplerInfo, build, build_nearest, find, split_spec,
+};
 pub use sobol::Sobol;
 
 use rayon::prelude::*;

@@ -232,7 +232,7 @@ pub const SAMPLERS: &[SamplerInfo] = &[
     SamplerInfo {
         name: "blue-noise",
         aliases: &["optimized"],
-        summary: "spectral descent from random points toward a target (default: disk family, CCVT-like blue noise)",
+        summary: "descent toward a target: on the torus (default: disk family, CCVT-like blue noise) or, with domain=square, on family MSEs of the unshifted estimator",
         dims: DimRange {
             min: 1,
             max: 4,
@@ -241,14 +241,19 @@ pub const SAMPLERS: &[SamplerInfo] = &[
         count: "any N",
         params: &[
             ParamInfo {
+                key: "domain",
+                default: "torus",
+                help: "torus (shift-randomized estimator) or square (unshifted, d = 2; N must be m^2, the jitter start)",
+            },
+            ParamInfo {
                 key: "target",
                 default: "family:disks",
-                help: "family:disks, power:A, radial:FILE.csv or an integrand spec (see varspec optimize points)",
+                help: "torus: family:disks, power:A, radial:FILE.csv or an integrand spec; square: default halfplanes+gaussians+16*blue (see varspec optimize points)",
             },
             ParamInfo {
                 key: "iters",
                 default: "1000",
-                help: "maximum descent iterations per set",
+                help: "maximum descent iterations per set (square: default 2000)",
             },
         ],
         build: optimized::from_config,
@@ -280,6 +285,15 @@ impl Config {
                     .map(|p| p.default)
             })
             .expect("parameter keys are registered")
+    }
+
+    /// The value of `key` if it was given.
+    pub fn given(&self, key: &str) -> Option<&str> {
+        self.params
+            .iter()
+            .rev()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.as_str())
     }
 
     /// An error for parameter `key` saying what is expected.
@@ -327,6 +341,34 @@ pub fn find(name: &str) -> Result<&'static SamplerInfo, SamplerError> {
         })
 }
 
+/// Sampler parameters as (key, value) pairs, later ones winning.
+pub type Params = Vec<(String, String)>;
+
+/// Splits `name:key=value,...` (shorthand for `name` with those
+/// parameters) into the name and the parameters, `params` appended after
+/// the shorthand's so they win.
+///
+/// # Errors
+/// [`SamplerError::Syntax`] for a part that is not key=value.
+pub fn split_spec<'a>(
+    name: &'a str,
+    params: &[(String, String)],
+) -> Result<(&'a str, Params), SamplerError> {
+    let Some((name, rest)) = name.split_once(':') else {
+        return Ok((name, params.to_vec()));
+    };
+    let mut all = Vec::new();
+    for part in rest.split(',').filter(|p| !p.is_empty()) {
+        let (k, v) = part.split_once('=').ok_or_else(|| SamplerError::Syntax {
+            spec: format!("{name}:{rest}"),
+            part: part.to_string(),
+        })?;
+        all.push((k.trim().to_string(), v.trim().to_string()));
+    }
+    all.extend_from_slice(params);
+    Ok((name, all))
+}
+
 /// Builds sampler `name` for N = `n` points in `dim` dimensions (the
 /// sampler's default when `None`) with `key=value` parameters.
 ///
@@ -340,23 +382,7 @@ pub fn build(
     dim: Option<usize>,
     params: &[(String, String)],
 ) -> Result<Box<dyn Sampler>, SamplerError> {
-    // `name:key=value,...` is shorthand for `name` with those parameters;
-    // parameters given separately come later and win.
-    let (name, params) = match name.split_once(':') {
-        None => (name, params.to_vec()),
-        Some((name, rest)) => {
-            let mut all = Vec::new();
-            for part in rest.split(',').filter(|p| !p.is_empty()) {
-                let (k, v) = part.split_once('=').ok_or_else(|| SamplerError::Syntax {
-                    spec: format!("{name}:{rest}"),
-                    part: part.to_string(),
-                })?;
-                all.push((k.trim().to_string(), v.trim().to_string()));
-            }
-            all.extend_from_slice(params);
-            (name, all)
-        }
-    };
+    let (name, params) = split_spec(name, params)?;
     let params = params.as_slice();
     let info = find(name)?;
     let sampler = info.name;

@@ -1,0 +1,37 @@
+//! Convex polygons in the plane: clipping by a half-plane
+//! (Sutherland & Hodgman 1974, "Reentrant polygon clipping", CACM 17(1))
+//! and area by the shoelace formula. Used for exact integrals of polygonal
+//! indicators (half-planes and boxes cut by the unit square).
+
+/// The convex polygon `poly` (counter-clockwise) clipped to n·x ≥ level
+/// (one Sutherland–Hodgman pass).
+pub fn clip(poly: &[[f64; 2]], n: [f64; 2], level: f64) -> Vec<[f64; 2]> {
+    let side = |p: [f64; 2]| p[0] * n[0] + p[1] * n[1] - level;
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (sa, sb) = (side(a), side(b));
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        if (sa >= 0.0) != (sb >= 0.0) {
+            let t = sa / (sa - sb);
+            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+        }
+    }
+    out
+}
+
+/// Area of a simple polygon (counter-clockwise positive).
+pub fn shoelace(poly: &[[f64; 2]]) -> f64 {
+    let n = poly.len();
+    0.5 * (0..n)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum::<f64>()
+}
+
+/// The unit square [0,1]², counter-clockwise.
+pub const UNIT_SQUARE: [[f64; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];

@@ -1,0 +1,75 @@
+//! The score of point sets on the square: the mean squared error of the
+//! unshifted estimator Î = (1/N) Σ_i f(x_i) over the members of a family,
+//! by brute force (each member evaluated at every point), with a standard
+//! error over the members. This is the peer's yardstick (UTK's integration
+//! tests: the average of (Î − I)² over a database of integrands) and the
+//! independent check of the kernel forms the optimizers use.
+
+use rayon::prelude::*;
+
+use super::family::Family;
+use crate::points::PointSet;
+use crate::variance::sum::NeumaierSum;
+
+/// A family MSE with its uncertainty.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SquareMse {
+    /// Mean of (Î − I)² over members and sets.
+    pub mse: f64,
+    /// Standard error over the members (the sets held fixed).
+    pub stderr: f64,
+    /// Members of the family sample.
+    pub members: usize,
+    /// MSE of each set over the members.
+    pub per_set: Vec<f64>,
+}
+
+/// The family MSE of `sets` over `members` members drawn with `seed`.
+///
+/// # Panics
+/// If a set is not 2D (callers check).
+pub fn family_mse(sets: &[PointSet], family: &Family, members: usize, seed: u64) -> SquareMse {
+    assert!(
+        sets.iter().all(|s| s.dim() == 2),
+        "the square holds 2D sets"
+    );
+    let members = family.sample_size(members);
+    // Per member: the squared error of every set.
+    let errors: Vec<Vec<f64>> = (0..members as u64)
+        .into_par_iter()
+        .map(|m| {
+            let f = family.member(seed, m);
+            let integral = f.integral();
+            sets.iter()
+                .map(|set| {
+                    let mut sum = NeumaierSum::default();
+                    for p in set.points() {
+                        sum.add(f.eval([p[0], p[1]]));
+                    }
+                    let e = sum.value() / set.len() as f64 - integral;
+                    e * e
+                })
+                .collect()
+        })
+        .collect();
+    let per_member: Vec<f64> = errors
+        .iter()
+        .map(|e| e.iter().sum::<f64>() / e.len().max(1) as f64)
+        .collect();
+    let mean = crate::variance::sum::sum(per_member.iter().copied()) / members as f64;
+    let spread = if members > 1 {
+        crate::variance::sum::sum(per_member.iter().map(|v| (v - mean) * (v - mean)))
+            / (members - 1) as f64
+    } else {
+        0.0
+    };
+    let per_set = (0..sets.len())
+        .map(|s| errors.iter().map(|e| e[s]).sum::<f64>() / members as f64)
+        .collect();
+    SquareMse {
+        mse: mean,
+        stderr: (spread / members as f64).sqrt(),
+        members,
+        per_set,
+    }
+}
