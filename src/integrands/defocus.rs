@@ -86,6 +86,10 @@ impl LightField for Defocus {
     fn layer_shears(&self) -> Vec<[f64; 2]> {
         vec![[-self.c, -self.c]]
     }
+
+    fn layer_shapes(&self) -> Vec<String> {
+        vec![self.g.spec()]
+    }
 }
 
 impl Integrand for Defocus {

@@ -126,4 +126,8 @@ impl LightField for Layers {
     fn layer_shears(&self) -> Vec<[f64; 2]> {
         self.layers.iter().flat_map(|l| l.layer_shears()).collect()
     }
+
+    fn layer_shapes(&self) -> Vec<String> {
+        self.layers.iter().flat_map(|l| l.layer_shapes()).collect()
+    }
 }

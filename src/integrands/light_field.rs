@@ -22,6 +22,9 @@ pub trait LightField: Send + Sync {
     /// The shear (a, b) that makes each layer constant along (u, v): the
     /// analytic answer a = b = −c for a layer of shear c.
     fn layer_shears(&self) -> Vec<[f64; 2]>;
+    /// The 2D shape g of each layer, as a catalogue spec (in the order of
+    /// [`Self::layer_shears`]).
+    fn layer_shapes(&self) -> Vec<String>;
 }
 
 /// ∫∫ |φ_k(u, v)|² du dv = Σ_(t,t′) A_t·conj(A_t′)·χ(ω_t − ω_t′), χ the

@@ -99,6 +99,25 @@ impl PointOptimizer {
             half: options.half,
         };
         let weights = target.weights(&freqs)?;
+        Self::with_weights(freqs, weights, options)
+    }
+
+    /// Plans the descent for given weights W(k) on `freqs` (box order).
+    ///
+    /// # Errors
+    /// A bad tolerance, or weights of another length than the box.
+    pub fn with_weights(
+        freqs: FrequencyBox,
+        weights: Vec<f64>,
+        options: DescentOptions,
+    ) -> Result<Self, OptimizeError> {
+        if weights.len() != freqs.len() {
+            return Err(OptimizeError::Option(format!(
+                "{} weights for a box of {} frequencies",
+                weights.len(),
+                freqs.len()
+            )));
+        }
         let plan = NufftPlan::new(freqs, options.tolerance)?;
         Ok(PointOptimizer {
             freqs,

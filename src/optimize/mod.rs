@@ -4,6 +4,7 @@
 
 pub mod adam;
 pub mod descent;
+pub mod projections;
 pub mod repulsion;
 pub mod shear;
 pub mod target;
