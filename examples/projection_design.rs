@@ -49,9 +49,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let seconds = clock.elapsed().as_secs_f64() / sets as f64;
     // Variance of the (x, y)-shifted estimator: 2000 shifts per fixed set.
     let per_set = |set: &varspec::PointSet| {
-        empirical_shifting(f.as_ref(), 2000, 5, &[0, 1], |_| -> Result<_, VarianceError> {
-            Ok(set.clone())
-        })
+        empirical_shifting(
+            f.as_ref(),
+            2000,
+            5,
+            &[0, 1],
+            |_| -> Result<_, VarianceError> { Ok(set.clone()) },
+        )
         .expect("4D")
         .variance
     };

@@ -25,7 +25,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let out = args.first().cloned().unwrap_or_else(|| "out/square".into());
     let ns: Vec<usize> = if args.len() > 1 {
-        args[1..].iter().map(|a| a.parse()).collect::<Result<_, _>>()?
+        args[1..]
+            .iter()
+            .map(|a| a.parse())
+            .collect::<Result<_, _>>()?
     } else {
         vec![1024, 4096]
     };
@@ -40,7 +43,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         header.push(format!("square {}", f.spec()));
         header.push(format!("square {} stderr", f.spec()));
     }
-    header.extend(["torus-shifted halfplanes".into(), "torus-shifted gaussians".into()]);
+    header.extend([
+        "torus-shifted halfplanes".into(),
+        "torus-shifted gaussians".into(),
+    ]);
     header.extend(["closest pair / hexagonal".into(), "seconds per set".into()]);
     csv.write_record(&header)?;
     let mut md = String::from(
@@ -118,7 +124,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 record.push(format!("{:e}", m.mse));
                 cells.push(format!("{:.3e}", m.mse));
             }
-            let closest = sets.iter().map(closest_pair_ratio).fold(f64::INFINITY, f64::min);
+            let closest = sets
+                .iter()
+                .map(closest_pair_ratio)
+                .fold(f64::INFINITY, f64::min);
             record.push(format!("{closest:.3}"));
             record.push(format!("{seconds:.3}"));
             csv.write_record(&record)?;

@@ -38,7 +38,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             integrands::parse(&spec).expect("valid spec")
         })
         .collect();
-    let powers: Vec<Vec<f64>> = members.iter().map(|f| integrand_power(f.as_ref(), &freqs)).collect();
+    let powers: Vec<Vec<f64>> = members
+        .iter()
+        .map(|f| integrand_power(f.as_ref(), &freqs))
+        .collect();
     let zero = freqs.zero_index();
     let mut table: Vec<(String, Vec<f64>)> = Vec::new();
     for name in &names {
@@ -48,7 +51,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             freqs,
             Method::Fast { tolerance: 1e-9 },
             sets,
-            |r| s.sample(&mut set_rng(11, r as u64)).map_err(|e| Box::<dyn std::error::Error + Send + Sync>::from(e.to_string())),
+            |r| {
+                s.sample(&mut set_rng(11, r as u64))
+                    .map_err(|e| Box::<dyn std::error::Error + Send + Sync>::from(e.to_string()))
+            },
             &|| {},
         )
         .map_err(|e| e.to_string())?;

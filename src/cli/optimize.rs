@@ -293,7 +293,9 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
             let first = init.sample(&mut set_rng(a.seed, r as u64))?;
             let objective = ProjectionObjective::new(&terms, &first);
             let before: Vec<f64> = terms.iter().map(|t| t.loss(&first)).collect();
-            let result = adam(first, &objective, &options, Domain::Torus, &|_, _| bar.inc(1));
+            let result = adam(first, &objective, &options, Domain::Torus, &|_, _| {
+                bar.inc(1)
+            });
             Ok((before, result))
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
@@ -313,8 +315,10 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
         let before = mean(results.iter().map(|r| r.0[t]).collect());
         let after = mean(sets.iter().map(|s| term.loss(s)).collect());
         println!("  {:<40} loss {before:.4e} -> {after:.4e}", term.label);
-        per_term.push(json!({"term": term.label, "weight": term.weight, "rows": term.rows,
-                             "loss_before": before, "loss_after": after}));
+        per_term.push(
+            json!({"term": term.label, "weight": term.weight, "rows": term.rows,
+                             "loss_before": before, "loss_after": after}),
+        );
     }
     let closest = |dims: [usize; 2]| -> anyhow::Result<f64> {
         let mut worst = f64::INFINITY;

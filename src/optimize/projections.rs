@@ -49,9 +49,8 @@ impl ProjectionTerm {
         let coords = points
             .points()
             .flat_map(|p| {
-                self.rows.map(|row| {
-                    wrap01(row.iter().zip(p).map(|(m, x)| m * x).sum::<f64>())
-                })
+                self.rows
+                    .map(|row| wrap01(row.iter().zip(p).map(|(m, x)| m * x).sum::<f64>()))
             })
             .collect();
         PointSet::new(2, coords).expect("wrapped coordinates lie in [0,1)")
@@ -115,8 +114,11 @@ pub fn parse_projections(spec: &str, n: usize) -> Result<Vec<ProjectionTerm>, Op
                 }
             }
             None => {
-                let f = integrands::parse(part)
-                    .map_err(|e| fail(format!("`{part}` is neither PLANE:SPEC nor a 4D light field: {e}")))?;
+                let f = integrands::parse(part).map_err(|e| {
+                    fail(format!(
+                        "`{part}` is neither PLANE:SPEC nor a 4D light field: {e}"
+                    ))
+                })?;
                 let light = f.light_field().filter(|l| l.layer_shears().len() == 1).ok_or_else(|| {
                     fail(format!(
                         "`{part}`: a 4D term must be a one-layer light field (defocus), whose variance is a sheared projection's"
@@ -148,7 +150,11 @@ pub fn parse_projections(spec: &str, n: usize) -> Result<Vec<ProjectionTerm>, Op
                         let mut k = [0i64; 4];
                         k[i] = k2[0];
                         k[j] = k2[1];
-                        if idx == zero { 0.0 } else { f.fourier(&k).norm_sqr() }
+                        if idx == zero {
+                            0.0
+                        } else {
+                            f.fourier(&k).norm_sqr()
+                        }
                     })
                     .collect();
                 PointOptimizer::with_weights(freqs, weights, options)?
