@@ -45,19 +45,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let zero = freqs.zero_index();
     let mut table: Vec<(String, Vec<f64>)> = Vec::new();
     for name in &names {
-        let (s, n_used) = samplers::build_nearest(name, n, Some(2), &[])?;
-        let sets = if name.starts_with("blue") { 4 } else { 16 };
+        // A point-set file, or a sampler.
+        let drawn: Vec<varspec::PointSet> = if name.ends_with(".csv") {
+            varspec::io::read_point_sets(std::path::Path::new(name))?
+        } else {
+            let (s, _) = samplers::build_nearest(name, n, Some(2), &[])?;
+            let count = if name.starts_with("blue") { 4 } else { 16 };
+            (0..count)
+                .map(|r| s.sample(&mut set_rng(11, r)))
+                .collect::<Result<_, _>>()?
+        };
+        let n_used = drawn[0].len();
         let spectrum = expected_power(
             freqs,
             Method::Fast { tolerance: 1e-9 },
-            sets,
-            |r| {
-                s.sample(&mut set_rng(11, r as u64))
-                    .map_err(|e| Box::<dyn std::error::Error + Send + Sync>::from(e.to_string()))
-            },
+            drawn.len(),
+            |r| Ok::<_, varspec::spectrum::SpectrumError>(drawn[r].clone()),
             &|| {},
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         let variances: Vec<f64> = members
             .iter()
             .zip(&powers)
@@ -73,6 +78,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 (in_box + (f.variance() - energy).max(0.0)) / n_used as f64
             })
             .collect();
+        // How much of the variance lies beyond |k|∞ = 80 (the descent's box
+        // at N = 1024): the tail no in-box design can change.
+        let outside: f64 = members
+            .iter()
+            .zip(&powers)
+            .zip(&variances)
+            .map(|((f, pf), v)| {
+                let mut inside = 0.0;
+                let mut energy = 0.0;
+                for (i, (&p, &w)) in spectrum.power.iter().zip(pf).enumerate() {
+                    let mut k = [0i64; 2];
+                    freqs.frequency(i, &mut k);
+                    if i != zero && k[0].abs() <= 80 && k[1].abs() <= 80 {
+                        inside += p * w;
+                        energy += w;
+                    }
+                }
+                let _ = inside;
+                ((f.variance() - energy).max(0.0) / n_used as f64) / v
+            })
+            .sum::<f64>()
+            / members.len() as f64;
+        eprintln!(
+            "{name}: share of the variance beyond |k| = 80 at white-noise level: {outside:.3}"
+        );
         table.push((format!("{name} (N={n_used})"), variances));
     }
     let (jitter, cmj) = (table[0].1.clone(), table[1].1.clone());
