@@ -214,3 +214,56 @@ fn compare_writes_a_table_and_pictures() {
     assert!(dir.join("cmj.png").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_main_job_writes_a_self_contained_report() {
+    let dir = std::env::temp_dir().join(format!("varspec-report-{}", std::process::id()));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args([
+            "report",
+            "-n",
+            "64",
+            "--sets",
+            "4",
+            "-o",
+            dir.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let html = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    for section in [
+        "1. Classic samplers",
+        "2. Designs for the unit square",
+        "3. Shear search",
+        "4. Speed against error",
+    ] {
+        assert!(html.contains(section), "missing section {section}");
+    }
+    // Pictures are embedded, so the page stands alone.
+    assert!(html.matches("data:image/png;base64,").count() >= 10);
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let rows = report["predict"]["rows"].as_array().unwrap();
+    // The three predictors agree: spatial within the empirical CI for jitter.
+    let jitter = &rows[1];
+    assert_eq!(jitter["sampler"], "jitter");
+    let spatial = jitter["spatial"].as_f64().unwrap();
+    assert!(
+        jitter["ci_low"].as_f64().unwrap() <= spatial
+            && spatial <= jitter["ci_high"].as_f64().unwrap(),
+        "{jitter}"
+    );
+    assert!(
+        std::fs::read_to_string(dir.join("variances.csv"))
+            .unwrap()
+            .lines()
+            .count()
+            == 7
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

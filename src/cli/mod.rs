@@ -12,6 +12,7 @@ mod pcf;
 mod plot;
 mod predict;
 mod progress;
+mod report;
 mod sample;
 mod source;
 mod spectrum;
@@ -31,6 +32,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job: the design loop end to end on built-in defaults, as one
+    /// self-contained HTML page (out/report/index.html) with its data.
+    Report(report::Args),
     /// Generate point sets with a sampler and write them as CSV or UTK text.
     Sample(sample::Args),
     /// Draw pictures (PNG) of point sets.
@@ -67,6 +71,7 @@ enum Command {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Report(a) => report::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Plot(c) => plot::run(c),
         Command::Compare(a) => compare::run(a),

@@ -1,0 +1,663 @@
+//! The design loop end to end on built-in defaults — the project's main
+//! job: classic samplers against an optimized set with the three variance
+//! predictors side by side, spectra and radial profiles, a design for the
+//! unit square, a shear search on a defocus pixel, and the spectrum's speed
+//! against its error. [`run_tour`] computes it ([`Tour`], serializable);
+//! [`super::html::render_tour`] writes the page.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::integrands;
+use crate::optimize::shear::{
+    ObjectiveOptions, ShearObjective, Sheared, search_shear, spectral_start,
+};
+use crate::points::PointSet;
+use crate::report::plot::{LinePlot, Series, line_plot_png, spectrum_png};
+use crate::report::png::{render_points, save_png};
+use crate::rng::set_rng;
+use crate::samplers::{self, Sampler};
+use crate::spectrum::radial::radial_profile;
+use crate::spectrum::{FrequencyBox, Method, expected_power};
+use crate::square::design::{closest_pair_ratio, default_options, design, parse_target};
+use crate::square::{Family, family_mse};
+use crate::variance::{VarianceError, empirical, fourier, spatial};
+
+/// What can stop the tour.
+#[derive(Debug, thiserror::Error)]
+pub enum TourError {
+    /// A library error, with the step it happened in.
+    #[error("{step}: {message}")]
+    Step {
+        /// The tour's step.
+        step: &'static str,
+        /// The error.
+        message: String,
+    },
+}
+
+fn at<E: std::fmt::Display>(step: &'static str) -> impl Fn(E) -> TourError {
+    move |e| TourError::Step {
+        step,
+        message: e.to_string(),
+    }
+}
+
+/// The tour's knobs (the defaults run in well under a minute on 2 cores).
+#[derive(Debug, Clone, Serialize)]
+pub struct TourOptions {
+    /// Points per set of section 1.
+    pub n: usize,
+    /// Sets per sampler.
+    pub sets: usize,
+    /// Seed of everything.
+    pub seed: u64,
+    /// Integrand of section 1.
+    pub integrand: String,
+    /// Defocus pixel of section 3.
+    pub pixel: String,
+    /// Where the pictures and data go.
+    pub folder: PathBuf,
+}
+
+impl Default for TourOptions {
+    fn default() -> Self {
+        TourOptions {
+            n: 256,
+            sets: 16,
+            seed: 0,
+            integrand: "disk:r=0.3".into(),
+            pixel: "defocus:shape=disk,size=0.3,c=0.45".into(),
+            folder: PathBuf::from("out/report"),
+        }
+    }
+}
+
+/// A picture: its file beside the page and a caption.
+#[derive(Debug, Clone, Serialize)]
+pub struct Figure {
+    /// File name in the report folder.
+    pub file: String,
+    /// Caption.
+    pub caption: String,
+}
+
+/// One sampler's row of section 1.
+#[derive(Debug, Clone, Serialize)]
+pub struct PredictRow {
+    /// Sampler.
+    pub sampler: String,
+    /// N used.
+    pub n: usize,
+    /// Fourier form.
+    pub fourier: f64,
+    /// Its truncation bound.
+    pub truncation_bound: f64,
+    /// Spatial form.
+    pub spatial: f64,
+    /// Its standard error over the sets.
+    pub spatial_stderr: f64,
+    /// Empirical variance.
+    pub empirical: f64,
+    /// 95% CI, low end.
+    pub ci_low: f64,
+    /// 95% CI, high end.
+    pub ci_high: f64,
+    /// Spatial variance over jitter's.
+    pub vs_jitter: f64,
+    /// Drawing time per set.
+    pub seconds_per_set: f64,
+    /// The lowest variance of the table.
+    pub best: bool,
+}
+
+/// Section 1.
+#[derive(Debug, Clone, Serialize)]
+pub struct PredictSection {
+    /// The integrand.
+    pub integrand: String,
+    /// Requested N.
+    pub n: usize,
+    /// Sets per sampler.
+    pub sets: usize,
+    /// Fourier box half-width.
+    pub half: usize,
+    /// Empirical realizations.
+    pub realizations: usize,
+    /// Rows.
+    pub rows: Vec<PredictRow>,
+    /// Pictures of one set each.
+    pub points: Vec<Figure>,
+    /// Spectra and the radial profiles.
+    pub spectra: Vec<Figure>,
+    /// Commands.
+    pub commands: Vec<String>,
+}
+
+/// One row of section 2.
+#[derive(Debug, Clone, Serialize)]
+pub struct SquareRow {
+    /// Sampler or design.
+    pub name: String,
+    /// Half-plane family MSE.
+    pub halfplanes: f64,
+    /// Gaussian family MSE.
+    pub gaussians: f64,
+    /// Closest pair over the hexagonal spacing.
+    pub closest: f64,
+    /// The lowest half-plane MSE.
+    pub best: bool,
+}
+
+/// Section 2.
+#[derive(Debug, Clone, Serialize)]
+pub struct SquareSection {
+    /// N.
+    pub n: usize,
+    /// Design target.
+    pub target: String,
+    /// Designed sets.
+    pub sets: usize,
+    /// Design time per set.
+    pub seconds_per_set: f64,
+    /// Members per family.
+    pub members: usize,
+    /// Rows.
+    pub rows: Vec<SquareRow>,
+    /// Pictures.
+    pub pictures: Vec<Figure>,
+    /// Commands.
+    pub commands: Vec<String>,
+}
+
+/// Section 3.
+#[derive(Debug, Clone, Serialize)]
+pub struct ShearSection {
+    /// The pixel.
+    pub integrand: String,
+    /// N.
+    pub n: usize,
+    /// Found shear.
+    pub shear: [f64; 2],
+    /// Spectral start.
+    pub initial: [f64; 2],
+    /// J there.
+    pub initial_value: f64,
+    /// Analytic shear −c.
+    pub analytic: f64,
+    /// J at (0, 0).
+    pub unsheared: f64,
+    /// J at the optimum.
+    pub optimum: f64,
+    /// Relative truncation bound.
+    pub truncation_bound: f64,
+    /// unsheared / optimum.
+    pub reduction: f64,
+    /// Empirical check before.
+    pub check_before: f64,
+    /// Its CI.
+    pub check_before_low: f64,
+    /// Its CI.
+    pub check_before_high: f64,
+    /// Empirical check after.
+    pub check_after: f64,
+    /// Its CI.
+    pub check_after_low: f64,
+    /// Its CI.
+    pub check_after_high: f64,
+    /// Search time.
+    pub seconds: f64,
+    /// XU/YV spectra before and after.
+    pub spectra: Vec<Figure>,
+    /// Commands.
+    pub commands: Vec<String>,
+}
+
+/// One row of section 4.
+#[derive(Debug, Clone, Serialize)]
+pub struct SpeedRow {
+    /// Method.
+    pub method: String,
+    /// Wall time.
+    pub seconds: f64,
+    /// Largest error against the direct sums.
+    pub max_error: f64,
+    /// Direct time / this time.
+    pub speedup: f64,
+}
+
+/// Section 4.
+#[derive(Debug, Clone, Serialize)]
+pub struct SpeedSection {
+    /// N.
+    pub n: usize,
+    /// Sets.
+    pub sets: usize,
+    /// Box half-width.
+    pub half: usize,
+    /// Rows.
+    pub rows: Vec<SpeedRow>,
+    /// Commands.
+    pub commands: Vec<String>,
+}
+
+/// The whole tour.
+#[derive(Debug, Clone, Serialize)]
+pub struct Tour {
+    /// The options it ran with.
+    pub options: TourOptions,
+    /// Section 1.
+    pub predict: PredictSection,
+    /// Section 2.
+    pub square: SquareSection,
+    /// Section 3.
+    pub shear: ShearSection,
+    /// Section 4.
+    pub speed: SpeedSection,
+    /// Total wall time.
+    pub seconds: f64,
+}
+
+fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Result<Vec<PointSet>, TourError> {
+    (0..sets as u64)
+        .map(|r| sampler.sample(&mut set_rng(seed, r)))
+        .collect::<Result<_, _>>()
+        .map_err(at("drawing sets"))
+}
+
+/// Runs the tour, writing its pictures into `options.folder`;
+/// `progress(step)` names each step as it starts.
+///
+/// # Errors
+/// [`TourError`] naming the step that failed.
+pub fn run_tour(options: &TourOptions, progress: &dyn Fn(&str)) -> Result<Tour, TourError> {
+    let clock = Instant::now();
+    std::fs::create_dir_all(&options.folder).map_err(at("creating the report folder"))?;
+    progress("samplers and predictors");
+    let predict = predict_section(options)?;
+    progress("a design for the square");
+    let square = square_section(options)?;
+    progress("shear search");
+    let shear = shear_section(options)?;
+    progress("speed against error");
+    let speed = speed_section(options)?;
+    Ok(Tour {
+        options: options.clone(),
+        predict,
+        square,
+        shear,
+        speed,
+        seconds: clock.elapsed().as_secs_f64(),
+    })
+}
+
+fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
+    let f = integrands::parse(&o.integrand).map_err(at("the integrand"))?;
+    let half = 127;
+    let realizations = 4000;
+    let names = [
+        "random",
+        "jitter",
+        "cmj",
+        "sobol",
+        "poisson-disk",
+        "blue-noise",
+    ];
+    let mut rows = Vec::new();
+    let mut points = Vec::new();
+    let mut spectra = Vec::new();
+    let mut profiles = Vec::new();
+    let freqs = FrequencyBox::from_resolution(2, 64);
+    for name in names {
+        let (sampler, n) =
+            samplers::build_nearest(name, o.n, Some(2), &[]).map_err(at("building a sampler"))?;
+        let start = Instant::now();
+        let sets = draw(sampler.as_ref(), o.seed, o.sets)?;
+        let seconds_per_set = start.elapsed().as_secs_f64() / o.sets as f64;
+        let lend = |r: usize| Ok::<_, VarianceError>(sets[r].clone());
+        let fe = fourier(f.as_ref(), half, 1e-10, sets.len(), lend).map_err(at("Fourier form"))?;
+        let se = spatial(f.as_ref(), sets.len(), lend).map_err(at("spatial form"))?;
+        let ee = empirical(f.as_ref(), realizations, o.seed ^ 0xe3, |r| {
+            Ok::<_, VarianceError>(&sets[r % sets.len()])
+        })
+        .map_err(at("empirical form"))?;
+        rows.push(PredictRow {
+            sampler: name.into(),
+            n,
+            fourier: fe.variance,
+            truncation_bound: fe.truncation_bound,
+            spatial: se.variance,
+            spatial_stderr: se.stderr,
+            empirical: ee.variance,
+            ci_low: ee.ci_low,
+            ci_high: ee.ci_high,
+            vs_jitter: 0.0,
+            seconds_per_set,
+            best: false,
+        });
+        let file = format!("points-{name}.png");
+        let img = render_points(&sets[0], [0, 1], 320).map_err(at("drawing points"))?;
+        save_png(&img, &o.folder.join(&file)).map_err(at("writing a picture"))?;
+        points.push(Figure {
+            file,
+            caption: format!("{name}, N = {n}"),
+        });
+        let spectrum = expected_power(
+            freqs,
+            Method::Fast { tolerance: 1e-9 },
+            sets.len(),
+            |r| Ok::<_, crate::spectrum::SpectrumError>(sets[r].clone()),
+            &|| {},
+        )
+        .map_err(at("spectrum"))?;
+        if matches!(name, "jitter" | "cmj" | "blue-noise") {
+            let file = format!("spectrum-{name}.png");
+            spectrum_png(&spectrum, &format!("{name} N={n}"), &o.folder.join(&file))
+                .map_err(at("writing a picture"))?;
+            spectra.push(Figure {
+                file,
+                caption: format!("{name}: E[N·P_S(k)], |k| < 32"),
+            });
+        }
+        profiles.push(Series {
+            label: name.into(),
+            points: radial_profile(&spectrum)
+                .iter()
+                .filter(|b| b.k > 0)
+                .map(|b| (b.k as f64, b.power))
+                .collect(),
+            reference: false,
+        });
+    }
+    let jitter = rows[1].spatial;
+    let best = rows.iter().map(|r| r.spatial).fold(f64::INFINITY, f64::min);
+    for r in &mut rows {
+        r.vs_jitter = r.spatial / jitter;
+        r.best = r.spatial == best;
+    }
+    let file = "radial-profiles.png".to_string();
+    line_plot_png(
+        &LinePlot {
+            title: format!("radial power, N = {}", o.n),
+            x_label: "|k|".into(),
+            y_label: "E[N P_S]".into(),
+            log_log: false,
+            series: profiles,
+        },
+        &o.folder.join(&file),
+    )
+    .map_err(at("writing a picture"))?;
+    spectra.push(Figure {
+        file,
+        caption: "radial averages".into(),
+    });
+    let commands = vec![
+        format!(
+            "varspec predict --sampler cmj -n {} --sets {} --seed {} --integrand {} --res 256",
+            o.n, o.sets, o.seed, o.integrand
+        ),
+        format!(
+            "varspec sample blue-noise -n {} --sets {} --seed {} -o bn.csv",
+            o.n, o.sets, o.seed
+        ),
+        format!("varspec predict bn.csv --integrand {}", o.integrand),
+        format!(
+            "varspec spectrum --sampler jitter -n {} --sets {} --res 64 --png s.png --radial r.csv",
+            o.n, o.sets
+        ),
+    ];
+    Ok(PredictSection {
+        integrand: f.spec(),
+        n: o.n,
+        sets: o.sets,
+        half,
+        realizations,
+        rows,
+        points,
+        spectra,
+        commands,
+    })
+}
+
+fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
+    let n = 256;
+    let target = "halfplanes+gaussians+16*blue";
+    let terms = parse_target(target).map_err(at("square target"))?;
+    let jitter = samplers::build("jitter", n, Some(2), &[]).map_err(at("jitter"))?;
+    let count = 2;
+    let start = Instant::now();
+    let designed: Vec<PointSet> = draw(jitter.as_ref(), o.seed, count)?
+        .into_iter()
+        .enumerate()
+        .map(|(r, s)| {
+            design(
+                &terms,
+                s,
+                o.seed ^ (r as u64 + 1),
+                &default_options(),
+                &|_, _| {},
+            )
+            .points
+        })
+        .collect();
+    let seconds_per_set = start.elapsed().as_secs_f64() / count as f64;
+    let members = 1024;
+    let (halfplanes, gaussians) = (
+        Family::HalfPlanes,
+        Family::parse("gaussians").map_err(at("family"))?,
+    );
+    let score_seed = o.seed ^ 0x5c0e;
+    let mut rows = Vec::new();
+    let mut score = |name: String, sets: &[PointSet]| {
+        rows.push(SquareRow {
+            name,
+            halfplanes: family_mse(sets, &halfplanes, members, score_seed).mse,
+            gaussians: family_mse(sets, &gaussians, members, score_seed).mse,
+            closest: sets
+                .iter()
+                .map(closest_pair_ratio)
+                .fold(f64::INFINITY, f64::min),
+            best: false,
+        });
+    };
+    score(format!("designed ({target})"), &designed);
+    for name in ["jitter", "cmj", "sobol"] {
+        let s = samplers::build(name, n, Some(2), &[]).map_err(at("a sampler"))?;
+        score(name.into(), &draw(s.as_ref(), o.seed ^ 7, 16)?);
+    }
+    let best = rows
+        .iter()
+        .map(|r| r.halfplanes)
+        .fold(f64::INFINITY, f64::min);
+    for r in &mut rows {
+        r.best = r.halfplanes == best;
+    }
+    let file = "square-design.png".to_string();
+    let img = render_points(&designed[0], [0, 1], 320).map_err(at("drawing points"))?;
+    save_png(&img, &o.folder.join(&file)).map_err(at("writing a picture"))?;
+    Ok(SquareSection {
+        n,
+        target: target.into(),
+        sets: count,
+        seconds_per_set,
+        members,
+        rows,
+        pictures: vec![Figure {
+            file,
+            caption: format!("designed for the square, N = {n}"),
+        }],
+        commands: vec![
+            format!(
+                "varspec optimize points --domain square -n {n} --target '{target}' --sets {count} -o sq.csv --report sq.json"
+            ),
+            "varspec predict --family halfplanes sq.csv".into(),
+        ],
+    })
+}
+
+fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
+    let n = 256;
+    let f = integrands::parse(&o.pixel).map_err(at("the pixel"))?;
+    let analytic = f
+        .light_field()
+        .map(|l| l.layer_shears()[0][0])
+        .ok_or_else(|| at("the pixel")("not a light field"))?;
+    let umj = samplers::build("umj", n, Some(4), &[]).map_err(at("umj"))?;
+    let start = Instant::now();
+    let spectral = spectral_start(f.as_ref(), 64, 2.0);
+    let mut starts = spectral.candidates();
+    starts.push([0.0, 0.0]);
+    let options = ObjectiveOptions {
+        seed: o.seed,
+        ..ObjectiveOptions::default()
+    };
+    let objective = ShearObjective::new(f.as_ref(), umj.as_ref(), &starts, options)
+        .map_err(at("shear objective"))?;
+    let found = search_shear(&objective, &spectral, 2.0).map_err(at("shear search"))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let check = |shear: [f64; 2]| {
+        let sheared = Sheared::new(umj.as_ref(), shear).map_err(at("shearing"))?;
+        crate::variance::empirical_shifting(f.as_ref(), 4000, o.seed ^ 1, &[0, 1], |r| {
+            Ok::<_, VarianceError>(sheared.sample(&mut set_rng(o.seed ^ 0x0e7a, r as u64))?)
+        })
+        .map_err(at("shear check"))
+    };
+    let (before, after) = (check([0.0, 0.0])?, check(found.shear)?);
+    let mut spectra = Vec::new();
+    let freqs = FrequencyBox::from_resolution(2, 64);
+    for (label, shear) in [("before", [0.0, 0.0]), ("after", found.shear)] {
+        let sheared = Sheared::new(umj.as_ref(), shear).map_err(at("shearing"))?;
+        let sets = draw(&sheared, o.seed, 16)?;
+        for (name, dims) in [("xu", [0usize, 2]), ("yv", [1, 3])] {
+            let spectrum = expected_power(
+                freqs,
+                Method::Fast { tolerance: 1e-9 },
+                sets.len(),
+                |r| {
+                    sets[r]
+                        .projected(&dims)
+                        .map_err(|e| crate::spectrum::SpectrumError::Pcf(e.to_string()))
+                },
+                &|| {},
+            )
+            .map_err(at("projection spectrum"))?;
+            let file = format!("shear-{name}-{label}.png");
+            spectrum_png(
+                &spectrum,
+                &format!("umj {name}, {label} shear"),
+                &o.folder.join(&file),
+            )
+            .map_err(at("writing a picture"))?;
+            spectra.push(Figure {
+                file,
+                caption: format!("{} projection, {label}", name.to_uppercase()),
+            });
+        }
+    }
+    Ok(ShearSection {
+        integrand: f.spec(),
+        n,
+        shear: found.shear,
+        initial: found.initial.0,
+        initial_value: found.initial.1,
+        analytic,
+        unsheared: found.unsheared.value,
+        optimum: found.optimum.value,
+        truncation_bound: objective.truncation_bound() / found.optimum.value,
+        reduction: found.unsheared.value / found.optimum.value,
+        check_before: before.variance,
+        check_before_low: before.ci_low,
+        check_before_high: before.ci_high,
+        check_after: after.variance,
+        check_after_low: after.ci_low,
+        check_after_high: after.ci_high,
+        seconds,
+        spectra,
+        commands: vec![format!(
+            "varspec optimize shear -n {n} --integrand {} --png-prefix shear --json",
+            o.pixel
+        )],
+    })
+}
+
+fn speed_section(o: &TourOptions) -> Result<SpeedSection, TourError> {
+    let (n, sets, half) = (1024, 8, 64);
+    let jitter = samplers::build("jitter", n, Some(2), &[]).map_err(at("jitter"))?;
+    let drawn = draw(jitter.as_ref(), o.seed, sets)?;
+    let freqs = FrequencyBox { dim: 2, half };
+    let run = |method: Method| -> Result<(f64, Vec<f64>), TourError> {
+        let start = Instant::now();
+        let s = expected_power(
+            freqs,
+            method,
+            sets,
+            |r| Ok::<_, crate::spectrum::SpectrumError>(drawn[r].clone()),
+            &|| {},
+        )
+        .map_err(at("spectrum"))?;
+        Ok((start.elapsed().as_secs_f64(), s.power))
+    };
+    let (direct_time, exact) = run(Method::Direct)?;
+    let mut rows = vec![SpeedRow {
+        method: "direct (exact)".into(),
+        seconds: direct_time,
+        max_error: 0.0,
+        speedup: 1.0,
+    }];
+    for tolerance in [1e-3, 1e-6, 1e-9, 1e-12] {
+        let (t, power) = run(Method::Fast { tolerance })?;
+        let max_error = power
+            .iter()
+            .zip(&exact)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        rows.push(SpeedRow {
+            method: format!("NUFFT, tolerance {tolerance:e}"),
+            seconds: t,
+            max_error,
+            speedup: direct_time / t,
+        });
+    }
+    Ok(SpeedSection {
+        n,
+        sets,
+        half,
+        rows,
+        commands: vec!["varspec bench spectrum".into()],
+    })
+}
+
+/// Writes `tour` as `report.json`, `variances.csv` and `square.csv` into
+/// `folder`.
+///
+/// # Errors
+/// [`TourError`] naming the file.
+pub fn write_data(tour: &Tour, folder: &Path) -> Result<(), TourError> {
+    let json = serde_json::to_string_pretty(tour).map_err(at("report.json"))?;
+    crate::io::write_atomic(&folder.join("report.json"), |w| {
+        w.write_all(json.as_bytes())
+    })
+    .map_err(at("report.json"))?;
+    let mut bytes = Vec::new();
+    {
+        let mut w = csv::Writer::from_writer(&mut bytes);
+        for row in &tour.predict.rows {
+            w.serialize(row).map_err(at("variances.csv"))?;
+        }
+        w.flush().map_err(at("variances.csv"))?;
+    }
+    crate::io::write_atomic(&folder.join("variances.csv"), |w| w.write_all(&bytes))
+        .map_err(at("variances.csv"))?;
+    let mut bytes = Vec::new();
+    {
+        let mut w = csv::Writer::from_writer(&mut bytes);
+        for row in &tour.square.rows {
+            w.serialize(row).map_err(at("square.csv"))?;
+        }
+        w.flush().map_err(at("square.csv"))?;
+    }
+    crate::io::write_atomic(&folder.join("square.csv"), |w| w.write_all(&bytes))
+        .map_err(at("square.csv"))
+}
