@@ -78,8 +78,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 (in_box + (f.variance() - energy).max(0.0)) / n_used as f64
             })
             .collect();
-        // How much of the variance lies beyond |k|∞ = 80 (the descent's box
-        // at N = 1024): the tail no in-box design can change.
+        // How much of the variance lies beyond the descent's box for the
+        // disk family at this N: the tail no in-box design can change.
+        let box_half = varspec::optimize::DescentOptions::for_target(
+            n,
+            2,
+            &varspec::optimize::Target::FamilyDisks,
+        )
+        .half as i64;
         let outside: f64 = members
             .iter()
             .zip(&powers)
@@ -90,7 +96,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 for (i, (&p, &w)) in spectrum.power.iter().zip(pf).enumerate() {
                     let mut k = [0i64; 2];
                     freqs.frequency(i, &mut k);
-                    if i != zero && k[0].abs() <= 80 && k[1].abs() <= 80 {
+                    if i != zero && k[0].abs() <= box_half && k[1].abs() <= box_half {
                         inside += p * w;
                         energy += w;
                     }
