@@ -30,6 +30,7 @@
 //! ```
 
 pub mod error;
+pub mod experiment;
 pub mod integrands;
 pub mod io;
 pub mod neighbours;

@@ -33,16 +33,16 @@ pub struct Args {
     #[arg(long)]
     integrand: String,
     /// Comma-separated N values (constrained samplers use the nearest valid N).
-    #[arg(long = "n", value_delimiter = ',', required = true)]
+    #[arg(short = 'n', long = "n", value_delimiter = ',', required = true)]
     ns: Vec<usize>,
     #[command(flatten)]
     draw: DrawArgs,
     /// Predictor (default: spatial, or fourier for integrands without c_f).
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
-    /// Fourier box |k| < K/2 for --method fourier.
-    #[arg(long, default_value_t = 256)]
-    res: usize,
+    /// Fourier box |k| < K/2 for --method fourier (default 256 in 2D, 21 in 4D).
+    #[arg(long)]
+    res: Option<usize>,
     /// CSV of N against variance.
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -59,12 +59,16 @@ struct Point {
     n: usize,
     variance: f64,
     stderr: f64,
+    truncation_bound: f64,
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let f = integrands::parse(&a.integrand)?;
     if a.ns.len() < 2 {
         bail!("--n needs at least two values to fit a slope");
+    }
+    if a.res.is_some_and(|r| r < 3) {
+        bail!("--res must be at least 3 (the box |k| < K/2 must hold a frequency besides 0)");
     }
     let method = a.method.unwrap_or(if f.dim() == 2 {
         MethodArg::Spatial
@@ -79,20 +83,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let realization = |r: usize| -> Result<_, VarianceError> {
             Ok(sampler.sample(&mut set_rng(a.draw.seed, r as u64))?)
         };
-        let (variance, stderr) = match method {
+        let (variance, stderr, truncation_bound) = match method {
             MethodArg::Spatial => {
                 let e = spatial(f.as_ref(), a.draw.sets, realization)?;
-                (e.variance, e.stderr)
+                (e.variance, e.stderr, 0.0)
             }
             MethodArg::Fourier => {
                 let e = fourier(
                     f.as_ref(),
-                    a.res.saturating_sub(1) / 2,
+                    a.res.map_or(varspec::variance::fourier_half(f.dim()), |r| {
+                        r.saturating_sub(1) / 2
+                    }),
                     1e-10,
                     a.draw.sets,
                     realization,
                 )?;
-                (e.variance, e.truncation_bound)
+                (e.variance, e.stderr, e.truncation_bound)
             }
         };
         if variance <= 0.0 {
@@ -100,11 +106,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 "N = {n}: predicted variance {variance:e} is not positive; a log-log slope needs positive values"
             );
         }
+        if let Some(p) = points.iter().find(|p: &&Point| p.n == n) {
+            bail!(
+                "--n {} and {requested} both become N = {n} for {} (constrained N); give N values that stay distinct",
+                p.requested,
+                a.sampler
+            );
+        }
         points.push(Point {
             requested,
             n,
             variance,
             stderr,
+            truncation_bound,
         });
         bar.inc(1);
     }
@@ -120,9 +134,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .collect();
     if let Some(path) = &a.csv {
         write_atomic(path, |w| {
-            writeln!(w, "n,variance,stderr")?;
+            writeln!(w, "n,variance,stderr,truncation_bound")?;
             for p in &points {
-                writeln!(w, "{},{:?},{:?}", p.n, p.variance, p.stderr)?;
+                writeln!(
+                    w,
+                    "{},{:?},{:?},{:?}",
+                    p.n, p.variance, p.stderr, p.truncation_bound
+                )?;
             }
             Ok(())
         })?;
@@ -161,7 +179,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "sampler": a.sampler, "integrand": f.spec(),
             "method": if method == MethodArg::Spatial { "spatial" } else { "fourier" },
             "sets": a.draw.sets,
-            "points": points.iter().map(|p| json!({"n": p.n, "variance": p.variance, "stderr": p.stderr})).collect::<Vec<_>>(),
+            "points": points.iter().map(|p| json!({"n": p.n, "requested": p.requested, "variance": p.variance, "stderr": p.stderr, "truncation_bound": p.truncation_bound})).collect::<Vec<_>>(),
             "slope": fit.slope, "slope_ci": fit.slope_ci.map(|(l, h)| vec![l, h]),
             "theory": theory, "adjusted_n": adjusted,
         });

@@ -50,8 +50,12 @@ enum Command {
     Predict(predict::Args),
     /// Variance against N, the fitted log-log slope with its CI, and theory.
     Converge(converge::Args),
-    /// Run a declarative experiment file and write its tables to results/.
+    /// Run a declarative experiment file (whole, or one --shard i/n of it)
+    /// and write its tables.
     Experiment(experiment::Args),
+    /// Merge an experiment's shard files into exactly the tables a single
+    /// run writes.
+    Merge(experiment::MergeArgs),
     /// Optimizers: point positions toward a target spectrum.
     #[command(subcommand)]
     Optimize(optimize::OptimizeCommand),
@@ -81,6 +85,7 @@ pub fn main() -> ExitCode {
         Command::Predict(a) => predict::run(a),
         Command::Converge(a) => converge::run(a),
         Command::Experiment(a) => experiment::run(a),
+        Command::Merge(a) => experiment::merge(a),
         Command::Optimize(c) => optimize::run(c),
         Command::Tables(a) => tables::run(a),
         Command::Integrands(a) => integrands::run(a),

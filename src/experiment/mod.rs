@@ -1,0 +1,15 @@
+//! Declarative experiments, as a library: a JSON file names samplers,
+//! integrands and sizes ([`Experiment`]); the work splits into items — one
+//! per (sampler, N), whose realizations every integrand shares — in a fixed
+//! order, so any 1/n of it ([`Shard`]) is a pure function of (i, n) and the
+//! shards' cells, merged in that order, are exactly the single run's
+//! (the partitioning of cargo-nextest's `--partition count:i/n` and of a
+//! Slurm job array). [`report`] writes the tables from the cells.
+
+mod report;
+mod run;
+mod spec;
+
+pub use report::write_results;
+pub use run::{Cell, Shard, ShardFile, merge_shards, run_items};
+pub use spec::{Experiment, ExperimentError};

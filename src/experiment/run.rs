@@ -1,0 +1,197 @@
+//! Running an experiment's items, whole or by shard, and merging shards.
+
+use serde::{Deserialize, Serialize};
+
+use super::spec::{Experiment, ExperimentError};
+use crate::integrands;
+use crate::samplers;
+use crate::variance::{VarianceError, sampler_variance};
+
+/// One (sampler, integrand, N) result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Cell {
+    /// Sampler index in the experiment.
+    pub sampler_index: usize,
+    /// Integrand index.
+    pub integrand_index: usize,
+    /// N index.
+    pub n_index: usize,
+    /// Sampler name.
+    pub sampler: String,
+    /// Canonical integrand spec.
+    pub integrand: String,
+    /// Requested N.
+    pub requested: usize,
+    /// N used.
+    pub n: usize,
+    /// Mean predicted variance over the sets.
+    pub variance: f64,
+    /// Its standard error.
+    pub stderr: f64,
+    /// `spatial` or `fourier`.
+    pub method: String,
+}
+
+/// A deterministic 1/count of the items: those with index ≡ `index` (mod
+/// `count`), 0-based.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// i.
+    pub index: usize,
+    /// n.
+    pub count: usize,
+}
+
+impl Shard {
+    /// The whole experiment.
+    pub const ALL: Shard = Shard { index: 0, count: 1 };
+
+    /// Parses `i/n` with 0 ≤ i < n.
+    ///
+    /// # Errors
+    /// A message stating the rule.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        let bad = || {
+            format!(
+                "--shard `{text}` must be i/n with 0 <= i < n (e.g. 0/4), as Slurm's array index"
+            )
+        };
+        let (i, n) = text.split_once('/').ok_or_else(bad)?;
+        let (index, count): (usize, usize) = (
+            i.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+
+    fn owns(&self, item: usize) -> bool {
+        item % self.count == self.index
+    }
+}
+
+/// What one shard writes: the experiment, which shard, and its cells.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShardFile {
+    /// The experiment as run.
+    pub experiment: Experiment,
+    /// The experiment file's path as given.
+    pub file: String,
+    /// The shard.
+    pub shard: Shard,
+    /// Its cells, in item order.
+    pub cells: Vec<Cell>,
+}
+
+/// Runs the items of `shard` (in order); `on_cell` is called per cell.
+///
+/// # Errors
+/// [`ExperimentError::Cell`] naming the sampler, N and integrand that failed.
+pub fn run_items(
+    e: &Experiment,
+    file: &str,
+    shard: Shard,
+    on_cell: &dyn Fn(),
+) -> Result<Vec<Cell>, ExperimentError> {
+    let functions: Vec<_> = e
+        .integrands
+        .iter()
+        .map(|s| integrands::parse(s).expect("validated with the experiment"))
+        .collect();
+    let dim = e.dim();
+    let mut cells = Vec::new();
+    for (item, (si, ni)) in e.items().into_iter().enumerate() {
+        if !shard.owns(item) {
+            continue;
+        }
+        let (sampler, requested) = (&e.samplers[si], e.n[ni]);
+        let fail = |integrand: &str, reason: String| ExperimentError::Cell {
+            file: file.to_string(),
+            sampler: sampler.clone(),
+            n: requested,
+            integrand: integrand.to_string(),
+            reason,
+        };
+        let (s, n) = samplers::build_nearest(sampler, requested, Some(dim), &[])
+            .map_err(|err| fail("-", err.to_string()))?;
+        // Realizations drawn once per item and shared by every integrand.
+        let sets = samplers::generate_sets(s.as_ref(), e.seed, e.sets, &|| {})
+            .map_err(|err| fail("-", err.to_string()))?;
+        for (fi, f) in functions.iter().enumerate() {
+            let p = sampler_variance(f.as_ref(), e.sets, |r| {
+                Ok::<_, VarianceError>(sets[r].clone())
+            })
+            .map_err(|err| fail(&f.spec(), err.to_string()))?;
+            cells.push(Cell {
+                sampler_index: si,
+                integrand_index: fi,
+                n_index: ni,
+                sampler: sampler.clone(),
+                integrand: f.spec(),
+                requested,
+                n,
+                variance: p.variance,
+                stderr: p.stderr,
+                method: p.method.to_string(),
+            });
+            on_cell();
+        }
+    }
+    Ok(cells)
+}
+
+/// The cells of a complete set of shards of one experiment, in the single
+/// run's order.
+///
+/// # Errors
+/// [`ExperimentError::Invalid`] when the shards disagree on the experiment,
+/// miss or repeat a shard.
+pub fn merge_shards(
+    shards: &[ShardFile],
+) -> Result<(Experiment, String, Vec<Cell>), ExperimentError> {
+    let first = shards.first().ok_or_else(|| ExperimentError::Invalid {
+        file: "-".into(),
+        reason: "no shard files to merge".into(),
+    })?;
+    let invalid = |reason: String| ExperimentError::Invalid {
+        file: first.file.clone(),
+        reason,
+    };
+    let count = first.shard.count;
+    let mut seen = vec![false; count];
+    for s in shards {
+        if s.experiment != first.experiment || s.shard.count != count {
+            return Err(invalid(format!(
+                "shard {}/{} belongs to another experiment or split than shard {}/{}",
+                s.shard.index, s.shard.count, first.shard.index, count
+            )));
+        }
+        if std::mem::replace(&mut seen[s.shard.index], true) {
+            return Err(invalid(format!(
+                "shard {}/{count} given twice",
+                s.shard.index
+            )));
+        }
+    }
+    if let Some(missing) = seen.iter().position(|s| !s) {
+        return Err(invalid(format!("shard {missing}/{count} is missing")));
+    }
+    let mut cells: Vec<Cell> = shards
+        .iter()
+        .flat_map(|s| s.cells.iter().cloned())
+        .collect();
+    let items = first.experiment.items();
+    let order = |c: &Cell| {
+        (
+            items
+                .iter()
+                .position(|&(s, n)| s == c.sampler_index && n == c.n_index)
+                .unwrap_or(usize::MAX),
+            c.integrand_index,
+        )
+    };
+    cells.sort_by_key(order);
+    Ok((first.experiment.clone(), first.file.clone(), cells))
+}

@@ -1,0 +1,110 @@
+//! The experiment file: what to run, validated before anything runs.
+
+use serde::{Deserialize, Serialize};
+
+/// What is wrong with an experiment or its run.
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    /// The file is not a valid experiment.
+    #[error("{file}: {reason}")]
+    Invalid {
+        /// The experiment file.
+        file: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A computation failed.
+    #[error("{file}: {sampler} at N = {n} on {integrand}: {reason}")]
+    Cell {
+        /// The experiment file.
+        file: String,
+        /// Sampler.
+        sampler: String,
+        /// Requested N.
+        n: usize,
+        /// Integrand.
+        integrand: String,
+        /// The error.
+        reason: String,
+    },
+}
+
+/// A declarative experiment (see docs/formats.md).
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Experiment {
+    /// A plain file name: the report's title and results/<name>.
+    pub name: String,
+    /// A paragraph for the report.
+    #[serde(default)]
+    pub description: String,
+    /// Sampler names (with `name:key=value` parameters if any).
+    pub samplers: Vec<String>,
+    /// Integrand specs, all of one dimension.
+    pub integrands: Vec<String>,
+    /// Requested N values (each sampler uses its nearest valid N).
+    pub n: Vec<usize>,
+    /// Realizations per (sampler, N).
+    #[serde(default = "default_sets")]
+    pub sets: usize,
+    /// Seed of the realizations.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+fn default_sets() -> usize {
+    16
+}
+
+impl Experiment {
+    /// Parses and validates the text of file `file`.
+    ///
+    /// # Errors
+    /// [`ExperimentError::Invalid`] naming the file and the rule broken.
+    pub fn parse(text: &str, file: &str) -> Result<Self, ExperimentError> {
+        let invalid = |reason: String| ExperimentError::Invalid {
+            file: file.to_string(),
+            reason,
+        };
+        let e: Experiment = serde_json::from_str(text)
+            .map_err(|err| invalid(format!("not a valid experiment: {err}")))?;
+        let plain = !e.name.is_empty()
+            && !matches!(e.name.as_str(), "." | "..")
+            && !e.name.contains(['/', '\\', '\0'])
+            && e.name.len() <= 100;
+        if !plain {
+            return Err(invalid(format!(
+                "name `{}` must be a plain file name (no / or \\, not empty, . or .., at most 100 bytes): it names the results folder",
+                e.name.escape_debug()
+            )));
+        }
+        if e.samplers.is_empty() || e.integrands.is_empty() || e.n.is_empty() || e.sets == 0 {
+            return Err(invalid(
+                "samplers, integrands and n must be non-empty and sets >= 1".into(),
+            ));
+        }
+        let mut dims = Vec::new();
+        for spec in &e.integrands {
+            let f = crate::integrands::parse(spec).map_err(|err| invalid(err.to_string()))?;
+            dims.push(f.dim());
+        }
+        if dims.iter().any(|&d| d != dims[0]) {
+            return Err(invalid(
+                "all integrands of an experiment must have the same dimension".into(),
+            ));
+        }
+        Ok(e)
+    }
+
+    /// The dimension of its integrands.
+    pub fn dim(&self) -> usize {
+        crate::integrands::parse(&self.integrands[0]).map_or(2, |f| f.dim())
+    }
+
+    /// Work items in their fixed order: (sampler index, N index).
+    pub fn items(&self) -> Vec<(usize, usize)> {
+        (0..self.samplers.len())
+            .flat_map(|s| (0..self.n.len()).map(move |n| (s, n)))
+            .collect()
+    }
+}

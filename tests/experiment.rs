@@ -1,0 +1,117 @@
+//! Experiments: a sharded run merged equals the single run byte for byte
+//! (for any split), names that would escape the output folder are refused,
+//! and a rerun leaves no stale file.
+
+mod common;
+
+use common::{assert_fails, temp_dir, varspec};
+
+const SMALL: &str = r#"{
+  "name": "small",
+  "description": "A small sweep for the tests.",
+  "samplers": ["random", "jitter", "cmj"],
+  "integrands": ["disk:r=0.3", "gaussian:sx=0.1"],
+  "n": [16, 64, 256],
+  "sets": 4,
+  "seed": 5
+}"#;
+
+fn ok(args: &[&str]) {
+    let out = varspec(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn shards_merged_equal_the_single_run_byte_for_byte() {
+    let dir = temp_dir("experiment");
+    let file = dir.join("small.json");
+    std::fs::write(&file, SMALL).unwrap();
+    let f = file.to_str().unwrap();
+    let single = dir.join("single");
+    ok(&["experiment", f, "-o", single.to_str().unwrap()]);
+    for count in [2, 4] {
+        let sharded = dir.join(format!("sharded-{count}"));
+        // Shards in reverse order: the merge must not depend on it.
+        for i in (0..count).rev() {
+            ok(&[
+                "experiment",
+                f,
+                "--shard",
+                &format!("{i}/{count}"),
+                "-o",
+                sharded.to_str().unwrap(),
+            ]);
+        }
+        ok(&["merge", sharded.to_str().unwrap()]);
+        for name in ["variances.csv", "slopes.csv", "README.md"] {
+            let (a, b) = (
+                std::fs::read(single.join(name)).unwrap(),
+                std::fs::read(sharded.join(name)).unwrap(),
+            );
+            assert!(a == b, "{name} differs after merging {count} shards");
+        }
+    }
+    // A missing shard is named.
+    let partial = dir.join("partial");
+    ok(&[
+        "experiment",
+        f,
+        "--shard",
+        "0/3",
+        "-o",
+        partial.to_str().unwrap(),
+    ]);
+    assert_fails(
+        &["merge", partial.to_str().unwrap()],
+        "shard 1/3 is missing",
+    );
+    assert_fails(&["experiment", f, "--shard", "3/3"], "0 <= i < n");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn names_that_leave_the_output_folder_are_refused() {
+    let dir = temp_dir("experiment-names");
+    for name in ["../../escaped", "/tmp/abs", "", "..", "a\\b"] {
+        let file = dir.join("bad.json");
+        std::fs::write(
+            &file,
+            SMALL.replace("\"small\"", &serde_json::to_string(name).unwrap()),
+        )
+        .unwrap();
+        assert_fails(&["experiment", file.to_str().unwrap()], "plain file name");
+    }
+    assert!(!dir.join("..").join("escaped").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_rerun_with_one_n_removes_the_stale_slopes() {
+    let dir = temp_dir("experiment-rerun");
+    let file = dir.join("e.json");
+    let out = dir.join("out");
+    std::fs::write(&file, SMALL).unwrap();
+    ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(out.join("slopes.csv").exists());
+    std::fs::write(&file, SMALL.replace("[16, 64, 256]", "[64]")).unwrap();
+    ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        !out.join("slopes.csv").exists(),
+        "stale slopes.csv left beside a one-N table"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
