@@ -267,3 +267,65 @@ fn the_main_job_writes_a_self_contained_report() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn one_grammar_across_commands() {
+    let dir = temp_dir("grammar");
+    let out = |args: &[&str]| {
+        let o = varspec(args);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        o.stdout
+    };
+    // -n and --n, positional and --sampler, give the same sets.
+    let a = out(&["sample", "cmj", "-n", "16", "--seed", "4"]);
+    let b = out(&["sample", "--sampler", "cmj", "--n", "16", "--seed", "4"]);
+    assert_eq!(a, b);
+    // converge takes -n like every other command.
+    out(&[
+        "converge",
+        "--sampler",
+        "jitter",
+        "--integrand",
+        "disk:r=0.3",
+        "-n",
+        "16,64",
+    ]);
+    // The blue-noise sampler and optimize points share their descent defaults.
+    let (s1, s2) = (dir.join("s1.csv"), dir.join("s2.csv"));
+    out(&[
+        "sample",
+        "blue-noise",
+        "-n",
+        "64",
+        "--seed",
+        "3",
+        "-o",
+        s1.to_str().unwrap(),
+    ]);
+    out(&[
+        "optimize",
+        "points",
+        "-n",
+        "64",
+        "--target",
+        "family:disks",
+        "--seed",
+        "3",
+        "-o",
+        s2.to_str().unwrap(),
+    ]);
+    assert_eq!(std::fs::read(&s1).unwrap(), std::fs::read(&s2).unwrap());
+    // integrands lists names; --list adds the parameters.
+    let short = String::from_utf8(out(&["integrands"])).unwrap();
+    let long = String::from_utf8(out(&["integrands", "--list"])).unwrap();
+    assert!(short.contains("layers") && !short.contains("c1=0.5"));
+    assert!(long.contains("c1=0.5"));
+    // Shell completions.
+    let bash = String::from_utf8(out(&["completions", "bash"])).unwrap();
+    assert!(bash.contains("varspec") && bash.contains("optimize"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -26,7 +26,7 @@ pub enum BenchCommand {
 #[derive(clap::Args)]
 pub struct PredictArgs {
     /// CSV of the table.
-    #[arg(long, default_value = "results/bench-predict.csv")]
+    #[arg(long, default_value = "out/bench/bench-predict.csv")]
     csv: PathBuf,
     /// Skip R = 1e5 empirical runs and N = 4096.
     #[arg(long)]
@@ -36,7 +36,7 @@ pub struct PredictArgs {
 #[derive(clap::Args)]
 pub struct SpectrumArgs {
     /// CSV of the table.
-    #[arg(long, default_value = "results/bench-spectrum.csv")]
+    #[arg(long, default_value = "out/bench/bench-spectrum.csv")]
     csv: PathBuf,
     /// Skip the 1,048,576-point case.
     #[arg(long)]
@@ -163,7 +163,10 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
             |r| {
                 jitter
                     .sample(&mut set_rng(2, r as u64))
-                    .map_err(|e| SpectrumError::Pcf(e.to_string()))
+                    .map_err(|e| SpectrumError::Realization {
+                        index: r,
+                        message: e.to_string(),
+                    })
             },
             &|| {},
         )

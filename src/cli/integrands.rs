@@ -1,23 +1,32 @@
-//! `varspec integrands --list`: the reference integrands and their parameters.
+//! `varspec integrands`: the reference integrands — their names and what
+//! they are, or with `--list` every parameter with its default too.
 
 use varspec::integrands::INTEGRANDS;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// List every integrand with its parameters (the default).
+    /// List every integrand with its parameters, defaults and meanings.
     #[arg(long)]
     list: bool,
 }
 
-pub fn run(_a: Args) -> anyhow::Result<()> {
+pub fn run(a: Args) -> anyhow::Result<()> {
     let mut out = String::new();
     for i in INTEGRANDS {
-        out += &format!("{} ({}D)\n    {}\n", i.name, i.dim, i.summary);
-        for (key, default, help) in i.params {
-            out += &format!("    {key}={default:<6} {help}\n");
+        if a.list {
+            out += &format!("{} ({}D)\n    {}\n", i.name, i.dim, i.summary);
+            for (key, default, help) in i.params {
+                out += &format!("    {key}={default:<6} {help}\n");
+            }
+        } else {
+            out += &format!("{:<10} {}D  {}\n", i.name, i.dim, i.summary);
         }
     }
-    out += "spec syntax: name:key=value,key=value (e.g. disk:r=0.3,cx=0.5,cy=0.5)\n";
+    out += "spec syntax: name:key=value,key=value (e.g. disk:r=0.3,cx=0.5,cy=0.5)";
+    if !a.list {
+        out += "; parameters: varspec integrands --list";
+    }
+    out += "\n";
     print!("{out}");
     Ok(())
 }

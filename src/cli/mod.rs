@@ -61,8 +61,13 @@ enum Command {
     Optimize(optimize::OptimizeCommand),
     /// Pattern tables for renderers: csv, json, raw f32/f64, C header, with metadata.
     Tables(tables::Args),
-    /// The reference integrands and their parameters.
+    /// The reference integrands (with --list: their parameters).
     Integrands(integrands::Args),
+    /// Print a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions {
+        /// The shell.
+        shell: clap_complete::Shell,
+    },
     /// Benchmarks that print speed against error.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -86,6 +91,16 @@ pub fn main() -> ExitCode {
         Command::Converge(a) => converge::run(a),
         Command::Experiment(a) => experiment::run(a),
         Command::Merge(a) => experiment::merge(a),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            clap_complete::generate(
+                shell,
+                &mut Cli::command(),
+                "varspec",
+                &mut std::io::stdout(),
+            );
+            Ok(())
+        }
         Command::Optimize(c) => optimize::run(c),
         Command::Tables(a) => tables::run(a),
         Command::Integrands(a) => integrands::run(a),

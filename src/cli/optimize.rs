@@ -30,7 +30,7 @@ pub struct ShearArgs {
     #[arg(long, default_value = "umj")]
     sampler: String,
     /// Points per set.
-    #[arg(short = 'n')]
+    #[arg(short = 'n', long = "n")]
     n: usize,
     /// 4D light field, e.g. defocus:shape=box,size=0.3,c=0.6 or layers:c1=0.5,c2=-0.2.
     #[arg(long)]
@@ -63,7 +63,7 @@ pub struct ShearArgs {
 #[derive(clap::Args)]
 pub struct PointsArgs {
     /// Points per set.
-    #[arg(short = 'n')]
+    #[arg(short = 'n', long = "n")]
     n: usize,
     /// Dimension (1 to 4).
     #[arg(short = 'd', long = "dim", default_value_t = 2)]
@@ -98,16 +98,19 @@ pub struct PointsArgs {
     /// from --seed on other streams).
     #[arg(long, default_value_t = 1)]
     score_seed: u64,
-    /// Box half-width K of the loss (default: 2.5·N^(1/d) for families and
-    /// power laws, 8·N^(1/d) within [32, 128] for integrands).
+    /// Frequency box |k| < K/2 of the loss, as in spectrum and predict
+    /// (default K = 2h + 1 with h = 2.5·N^(1/d) within [16, 400] for families
+    /// and power laws, 8·N^(1/d) within [32, 256] for integrands).
     #[arg(long)]
-    half: Option<usize>,
-    /// NUFFT tolerance of the loss and gradient (the speed/accuracy knob).
-    #[arg(long, default_value_t = 1e-5)]
-    tol: f64,
-    /// Stop when the loss improves by less than this, relatively, over 50 iterations.
-    #[arg(long, default_value_t = 1e-3)]
-    rel_tol: f64,
+    res: Option<usize>,
+    /// NUFFT tolerance of the loss and gradient (the speed/accuracy knob;
+    /// default 1e-6, as the blue-noise sampler).
+    #[arg(long)]
+    tol: Option<f64>,
+    /// Stop when the loss improves by less than this, relatively, over 50
+    /// iterations (default 1e-4, as the blue-noise sampler; 0: never).
+    #[arg(long)]
+    rel_tol: Option<f64>,
     /// Output point-set file (CSV).
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
@@ -159,12 +162,20 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     let iters = a.iters.unwrap_or(1000);
     let mut options = DescentOptions::for_target(a.n, a.dim, &target);
     options.iters = iters;
-    options.tolerance = a.tol;
-    options.rel_tol = a.rel_tol;
-    if let Some(h) = a.half {
-        options.half = h;
+    if let Some(t) = a.tol {
+        options.tolerance = t;
+    }
+    if let Some(r) = a.rel_tol {
+        options.rel_tol = r;
+    }
+    if let Some(res) = a.res {
+        if res < 3 {
+            bail!("--res must be at least 3 (the box |k| < K/2 must hold a frequency besides 0)");
+        }
+        options.half = (res - 1) / 2;
     }
     let half = options.half;
+    let options_tolerance = options.tolerance;
     let optimizer = PointOptimizer::new(a.dim, &target, options)?;
     let init = samplers::build(&init_name, a.n, Some(a.dim), &[])?;
     let bar = progress::bar((a.sets * iters) as u64, "optimizing");
@@ -291,7 +302,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     if let Some(path) = &a.report {
         let report = json!({
             "target": a.target, "n": a.n, "dim": a.dim, "sets": a.sets, "seed": a.seed, "init": init_name, "domain": "torus",
-            "half": half, "tolerance": a.tol, "seconds": seconds, "iterations": iterations,
+            "half": half, "res": 2 * half + 1, "tolerance": options_tolerance, "seconds": seconds, "iterations": iterations,
             "loss": "sum over 0 < |k|inf <= half of W(k) P_S(k)  (for an integrand target: its predicted variance within the box)",
             "loss_curve": results[0].losses, "loss_curve_seconds": results[0].seconds, "comparison": comparison,
             "exact_variance": exact,
@@ -315,7 +326,7 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     let init = samplers::build(&init_name, a.n, Some(4), &[])?;
     let options = AdamOptions {
         iters: a.iters.unwrap_or(1000),
-        rel_tol: a.rel_tol,
+        rel_tol: a.rel_tol.unwrap_or(1e-4),
         step: 0.05,
         final_step: 0.002,
         score_every: 1,

@@ -54,14 +54,15 @@ pub struct Args {
 }
 
 /// Wraps a library error so `?` works inside the realization closures.
-fn lift(e: anyhow::Error) -> VarianceError {
+fn lift(index: usize, e: anyhow::Error) -> VarianceError {
     match e.downcast::<VarianceError>() {
         Ok(v) => v,
         Err(e) => match e.downcast::<varspec::samplers::SamplerError>() {
             Ok(s) => VarianceError::Sampler(s),
-            Err(e) => {
-                VarianceError::Spectrum(varspec::spectrum::SpectrumError::Pcf(format!("{e:#}")))
-            }
+            Err(e) => VarianceError::Realization {
+                index,
+                message: format!("{e:#}"),
+            },
         },
     }
 }
@@ -124,7 +125,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let start = Instant::now();
         let seed = 0x454d_5049_5249_4341;
         let e = empirical(f.as_ref(), a.realizations, seed, |r| {
-            source.get_cyclic(r).map_err(lift)
+            source.get_cyclic(r).map_err(|e| lift(r, e))
         })?;
         out.insert(
             "empirical".into(),

@@ -30,11 +30,14 @@ impl From<Format> for PointFormat {
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Sampler name (see --list).
-    #[arg(required_unless_present = "list")]
+    /// Sampler name (see --list), with `name:key=value,...` parameters if any.
+    #[arg(required_unless_present_any = ["list", "sampler_flag"], conflicts_with = "sampler_flag")]
     sampler: Option<String>,
+    /// The same as the positional sampler name (as in the other commands).
+    #[arg(long = "sampler", value_name = "SAMPLER")]
+    sampler_flag: Option<String>,
     /// Points per set.
-    #[arg(short = 'n', required_unless_present = "list")]
+    #[arg(short = 'n', long = "n", required_unless_present = "list")]
     n: Option<usize>,
     /// Dimension (default: the sampler's own, 2 for most, 4 for umj).
     #[arg(short = 'd', long = "dim")]
@@ -64,7 +67,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return list();
     }
     let (name, n) = (
-        a.sampler.expect("clap requires it"),
+        a.sampler.or(a.sampler_flag).expect("clap requires one"),
         a.n.expect("clap requires it"),
     );
     if a.sets == 0 {

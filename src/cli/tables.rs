@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long)]
     from: Option<PathBuf>,
     /// Points per set (with --sampler).
-    #[arg(short = 'n')]
+    #[arg(short = 'n', long = "n")]
     n: Option<usize>,
     /// Dimension (with --sampler).
     #[arg(short = 'd', long = "dim")]

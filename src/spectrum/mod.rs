@@ -55,6 +55,14 @@ pub enum SpectrumError {
     /// Nothing to average.
     #[error("no point sets to analyse")]
     NoSets,
+    /// A realization could not be produced (a file's set, a projection).
+    #[error("realization {index}: {message}")]
+    Realization {
+        /// Which realization.
+        index: usize,
+        /// What went wrong.
+        message: String,
+    },
     /// A bad pair-correlation parameter.
     #[error("pair correlation: {0}")]
     Pcf(String),

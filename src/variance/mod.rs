@@ -51,6 +51,14 @@ pub enum VarianceError {
         /// Another.
         other: usize,
     },
+    /// A realization could not be produced (a file's set, a projection).
+    #[error("realization {index}: {message}")]
+    Realization {
+        /// Which realization.
+        index: usize,
+        /// What went wrong.
+        message: String,
+    },
     /// Too few realizations for a variance.
     #[error("{what} needs at least {needed} realizations, got {got}")]
     TooFew {
