@@ -329,3 +329,77 @@ fn one_grammar_across_commands() {
     assert!(bash.contains("varspec") && bash.contains("optimize"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn numpy_outputs_load_back() {
+    let dir = temp_dir("npy");
+    let pts = dir.join("j.npy");
+    let run = varspec(&[
+        "sample",
+        "jitter",
+        "-n",
+        "16",
+        "--sets",
+        "3",
+        "-o",
+        pts.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(std::fs::read(&pts).unwrap().starts_with(b"\x93NUMPY"));
+    let csv = varspec(&["sample", "jitter", "-n", "16", "--sets", "3"]);
+    let csv_path = dir.join("j.csv");
+    std::fs::write(&csv_path, &csv.stdout).unwrap();
+    assert_eq!(
+        varspec::io::read_point_sets(&pts).unwrap(),
+        varspec::io::read_point_sets(&csv_path).unwrap()
+    );
+    // The spectrum of the .npy sets as an array: [2h+1, 2h+1] with h = 7
+    // for --res 16, DC (= N) at the centre.
+    let spec = dir.join("s.npy");
+    let run = varspec(&[
+        "spectrum",
+        pts.to_str().unwrap(),
+        "--res",
+        "16",
+        "--method",
+        "direct",
+        "--npy",
+        spec.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let bytes = std::fs::read(&spec).unwrap();
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = String::from_utf8_lossy(&bytes[10..10 + header_len]).replace(' ', "");
+    assert!(header.contains("'shape':(15,15"), "{header}");
+    let at = |row: usize, col: usize| {
+        let o = 10 + header_len + 8 * (row * 15 + col);
+        f64::from_le_bytes(bytes[o..o + 8].try_into().unwrap())
+    };
+    assert!((at(7, 7) - 16.0).abs() < 1e-12, "DC power {}", at(7, 7));
+    // Layout: one value against the CSV form of the same spectrum.
+    let csv_spec = dir.join("s.csv");
+    let run = varspec(&[
+        "spectrum",
+        pts.to_str().unwrap(),
+        "--res",
+        "16",
+        "--method",
+        "direct",
+        "--csv",
+        csv_spec.to_str().unwrap(),
+    ]);
+    assert!(run.status.success());
+    let text = std::fs::read_to_string(&csv_spec).unwrap();
+    let row = text.lines().find(|l| l.starts_with("3,-2,")).unwrap();
+    let power: f64 = row.rsplit(',').next().unwrap().parse().unwrap();
+    assert_eq!(at(7 - 2, 7 + 3), power, "row ky + h, column kx + h");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

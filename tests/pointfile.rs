@@ -232,3 +232,120 @@ fn empty_files_and_wrong_dimensions_are_errors() {
     assert!(missing.to_string().contains("missing.csv"), "{missing}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn limits_and_encodings() {
+    // A byte-order mark (as spreadsheets write) is skipped.
+    let sets = parse("\u{feff}x0,x1\n0.1,0.2\n").unwrap();
+    assert_eq!(sets[0].coords(), &[0.1, 0.2]);
+    // Quoted fields and CRLF line ends, as RFC 4180 allows.
+    let sets = parse("x0,x1\r\n\"0.25\",0.5\r\n").unwrap();
+    assert_eq!(sets[0].coords(), &[0.25, 0.5]);
+    // An endless line (a device, a binary file) is refused, not read into memory.
+    let huge = "1".repeat(2 << 20);
+    let err = parse(&huge).unwrap_err().to_string();
+    assert!(err.contains("longer than"), "{err}");
+    // A long bad header is quoted by a short, escaped prefix.
+    let header = format!("{}\0,x1\n0.1,0.2\n", "y".repeat(100_000));
+    let err = parse(&header).unwrap_err().to_string();
+    assert!(err.len() < 300 && err.contains('…'), "{err}");
+}
+
+/// A version-1.0 `.npy` file built by hand from the format's specification
+/// (numpy.lib.format: magic, version, little-endian u16 header length, an
+/// ASCII dict padded with spaces and `\n` to a multiple of 64 bytes).
+fn npy_by_hand(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> {
+    let dict = format!(
+        "{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}",
+        if fortran { "True" } else { "False" }
+    );
+    let unpadded = 10 + dict.len() + 1;
+    let pad = unpadded.next_multiple_of(64) - unpadded;
+    let header = format!("{dict}{}\n", " ".repeat(pad));
+    let mut out = b"\x93NUMPY\x01\x00".to_vec();
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    out.extend_from_slice(data);
+    out
+}
+
+#[test]
+fn npy_point_sets_round_trip_and_read_what_numpy_writes() {
+    let dir = std::env::temp_dir().join(format!("varspec-npy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sampler = samplers::build("random", 5, Some(3), &[]).unwrap();
+    let sets: Vec<PointSet> = (0..2)
+        .map(|r| sampler.sample(&mut set_rng(4, r)).unwrap())
+        .collect();
+    let path = dir.join("sets.npy");
+    write_atomic(&path, |w| varspec::io::npy::write_point_sets_npy(w, &sets)).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    // The header numpy.load reads, then the coordinates as little-endian f64.
+    assert!(bytes.starts_with(b"\x93NUMPY"));
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    assert!(header.contains("'descr': '<f8'"), "{header}");
+    assert!(header.contains("'fortran_order': False"), "{header}");
+    // A Python tuple: a trailing comma is allowed.
+    let tuple = header.replace(" ", "").replace(",)", ")");
+    assert!(tuple.contains("'shape':(2,5,3)"), "{header}");
+    let data: Vec<f64> = bytes[10 + header_len..]
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let expected: Vec<f64> = sets.iter().flat_map(|s| s.coords().to_vec()).collect();
+    assert_eq!(data, expected);
+    assert_eq!(read_point_sets(&path).unwrap(), sets);
+
+    // float32 in Fortran order, shape [N, d] = [3, 2]: column-major data.
+    let points = [[0.5f32, 0.25], [0.125, 0.75], [0.0, 0.5]];
+    let mut data = Vec::new();
+    for j in 0..2 {
+        for p in &points {
+            data.extend_from_slice(&p[j].to_le_bytes());
+        }
+    }
+    let path = dir.join("fortran.npy");
+    std::fs::write(&path, npy_by_hand("<f4", true, "(3, 2)", &data)).unwrap();
+    let read = read_point_sets(&path).unwrap();
+    assert_eq!(read.len(), 1);
+    assert_eq!(read[0].coords(), &[0.5, 0.25, 0.125, 0.75, 0.0, 0.5]);
+
+    // What is refused, and how it is said.
+    let refuse = |name: &str, bytes: Vec<u8>, needle: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let message = read_point_sets(&path).unwrap_err().to_string();
+        assert!(
+            message.contains(name) && message.contains(needle),
+            "{name}: {message}"
+        );
+    };
+    let one = 1.0f64.to_le_bytes().to_vec();
+    refuse(
+        "one.npy",
+        npy_by_hand("<f8", false, "(1, 1)", &one),
+        "[0, 0, 0] is 1",
+    );
+    refuse(
+        "flat.npy",
+        npy_by_hand("<f8", false, "(1,)", &[0; 8]),
+        "shape",
+    );
+    refuse(
+        "ints.npy",
+        npy_by_hand("<i8", false, "(1, 1)", &[0; 8]),
+        "dtype",
+    );
+    refuse(
+        "short.npy",
+        npy_by_hand("<f8", false, "(4, 2)", &[0; 8]),
+        "cut short",
+    );
+    refuse(
+        "empty.npy",
+        npy_by_hand("<f8", false, "(0, 2)", &[]),
+        "no points",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,13 +1,15 @@
 //! `varspec sample`: generate point sets.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
 
 use super::{args, progress};
+use varspec::io::npy::write_point_sets_npy;
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
+use varspec::points::PointSet;
 use varspec::samplers::{self, SAMPLERS};
 
 /// Point-set file formats.
@@ -17,13 +19,25 @@ pub enum Format {
     Csv,
     /// UTK whitespace text, `#` between sets.
     Utk,
+    /// NumPy float64 array of shape [sets, N, d] (`numpy.load`).
+    Npy,
 }
 
-impl From<Format> for PointFormat {
-    fn from(f: Format) -> Self {
-        match f {
-            Format::Csv => PointFormat::Csv,
-            Format::Utk => PointFormat::Utk,
+impl Format {
+    /// The format asked for, else the one the output's extension names
+    /// (`.npy`), else CSV.
+    fn resolve(asked: Option<Format>, output: Option<&Path>) -> Format {
+        asked.unwrap_or(match output.and_then(Path::extension) {
+            Some(ext) if ext.eq_ignore_ascii_case("npy") => Format::Npy,
+            _ => Format::Csv,
+        })
+    }
+
+    fn write(self, out: &mut dyn Write, sets: &[PointSet]) -> std::io::Result<()> {
+        match self {
+            Format::Csv => write_point_sets(out, sets, PointFormat::Csv),
+            Format::Utk => write_point_sets(out, sets, PointFormat::Utk),
+            Format::Npy => write_point_sets_npy(out, sets),
         }
     }
 }
@@ -54,9 +68,9 @@ pub struct Args {
     /// Output file (default: standard output).
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
-    /// Output format.
-    #[arg(long, value_enum, default_value_t = Format::Csv)]
-    format: Format,
+    /// Output format (default: npy for an `-o` ending in .npy, else csv).
+    #[arg(long, value_enum)]
+    format: Option<Format>,
     /// List every sampler with its dimensions, constraint on N and parameters.
     #[arg(long)]
     list: bool,
@@ -77,12 +91,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
     let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|| bar.inc(1))?;
     bar.finish_and_clear();
-    let format = a.format.into();
+    let format = Format::resolve(a.format, a.output.as_deref());
     match &a.output {
-        Some(path) => write_atomic(path, |w| write_point_sets(w, &sets, format))?,
+        Some(path) => write_atomic(path, |w| format.write(w, &sets))?,
         None => {
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
-            write_point_sets(&mut out, &sets, format).context("writing to standard output")?;
+            format
+                .write(&mut out, &sets)
+                .context("writing to standard output")?;
             out.flush().context("writing to standard output")?;
         }
     }

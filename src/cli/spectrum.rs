@@ -7,6 +7,7 @@ use clap::ValueEnum;
 
 use super::progress;
 use super::source::SourceArgs;
+use varspec::io::npy::write_npy;
 use varspec::io::write_atomic;
 use varspec::report::plot::{LinePlot, Series, line_plot_png, spectrum_png};
 use varspec::spectrum::expected::check_memory;
@@ -37,6 +38,10 @@ pub struct Args {
     /// CSV of the spectrum: kx,ky,power.
     #[arg(long)]
     csv: Option<PathBuf>,
+    /// NumPy float64 array [S, S] of the spectrum, S = 2h + 1 with h the
+    /// largest |k| in the box: row k_y + h, column k_x + h (DC at the centre).
+    #[arg(long)]
+    npy: Option<PathBuf>,
     /// CSV of the radial profile: k,power,anisotropy.
     #[arg(long)]
     radial: Option<PathBuf>,
@@ -83,6 +88,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             Ok(())
         })?;
     }
+    if let Some(path) = &a.npy {
+        let side = freqs.side() as u64;
+        write_atomic(path, |w| write_npy(w, &[side, side], &spectrum.power))?;
+    }
     if let Some(path) = &a.radial {
         write_atomic(path, radial_csv)?;
     }
@@ -111,7 +120,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         line_plot_png(&plot, path)?;
     }
-    if a.csv.is_none() && a.radial.is_none() && a.png.is_none() && a.radial_png.is_none() {
+    if a.csv.is_none()
+        && a.npy.is_none()
+        && a.radial.is_none()
+        && a.png.is_none()
+        && a.radial_png.is_none()
+    {
         let mut out = std::io::stdout().lock();
         radial_csv(&mut out)?;
     }

@@ -1,6 +1,7 @@
 //! File formats and atomic output.
 
 pub mod atomic;
+pub mod npy;
 pub mod pointfile;
 pub mod tables;
 

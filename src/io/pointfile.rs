@@ -16,6 +16,7 @@ use std::fs::File;
 use std::io::{self, BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 
+use super::npy;
 use crate::points::PointSet;
 
 /// What is wrong with a point-set file, and where.
@@ -44,6 +45,14 @@ pub enum PointFileError {
         line: usize,
         /// What is wrong on it.
         problem: LineProblem,
+    },
+    /// A NumPy `.npy` file that is not a point-set array.
+    #[error("{path}: {problem}")]
+    Npy {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
     },
     /// The points have another dimension than the caller needs.
     #[error("{path}: points are {found}-dimensional, {expected} dimensions are needed")]
@@ -162,16 +171,25 @@ pub enum PointFormat {
     Utk,
 }
 
-/// Reads every point set in `path` (CSV or UTK text, detected).
+/// Reads every point set in `path` (CSV, UTK text or NumPy `.npy`,
+/// detected from the content).
 ///
 /// # Errors
 /// [`PointFileError`] naming the file and, for malformed content, the line.
 pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
-    let file = File::open(path).map_err(|cause| PointFileError::Io {
+    let io = |cause| PointFileError::Io {
         path: path.into(),
         cause,
-    })?;
-    parse_point_sets(BufReader::new(file), path)
+    };
+    let file = File::open(path).map_err(io)?;
+    let mut reader = BufReader::new(file);
+    if reader.fill_buf().map_err(io)?.starts_with(npy::MAGIC) {
+        return npy::read_point_sets_npy(reader).map_err(|problem| PointFileError::Npy {
+            path: path.into(),
+            problem,
+        });
+    }
+    parse_point_sets(reader, path)
 }
 
 /// Reads `path` and checks that its points have dimension `dim`.
@@ -190,7 +208,19 @@ pub fn read_point_sets_of_dim(path: &Path, dim: usize) -> Result<Vec<PointSet>, 
     }
 }
 
+/// The longest line a point-set file may have: 1 MiB, far above any row of
+/// coordinates (a 64-dimensional row of round-trip f64 is about 1.5 kB).
+pub const MAX_LINE: usize = 1 << 20;
+
 /// Parses point sets from `reader`; `path` names the source in errors.
+///
+/// The format is detected from the first non-blank line. CSV goes through
+/// the `csv` crate (quoting, CRLF and trimming as its RFC 4180 reader does);
+/// UTK text is not CSV (whitespace-separated, `#` separators) and keeps its
+/// own line reader. A UTF-8 byte-order mark at the start is skipped. No line
+/// may exceed [`MAX_LINE`] bytes (a device such as /dev/zero is refused
+/// instead of read into memory), and a bad header is quoted by a short,
+/// escaped prefix.
 ///
 /// # Errors
 /// As [`read_point_sets`].
@@ -207,20 +237,107 @@ pub fn parse_point_sets<R: BufRead>(
         set_id: None,
         format: None,
     };
-    for (idx, line) in reader.lines().enumerate() {
-        let line = line.map_err(|cause| PointFileError::Io {
+    let io = |cause: io::Error| PointFileError::Io {
+        path: path.into(),
+        cause,
+    };
+    let at = |line: usize| {
+        move |problem| PointFileError::Line {
             path: path.into(),
-            cause,
-        })?;
-        parser
-            .line(line.trim_end_matches('\r'))
-            .map_err(|problem| PointFileError::Line {
-                path: path.into(),
-                line: idx + 1,
-                problem,
-            })?;
+            line,
+            problem,
+        }
+    };
+    let mut reader = BufReader::new(LineLimit {
+        inner: reader,
+        column: 0,
+        line: 1,
+    });
+    // The first non-blank line decides the format.
+    let mut first = String::new();
+    let mut line = 0;
+    loop {
+        first.clear();
+        if reader.read_line(&mut first).map_err(io)? == 0 {
+            return parser.finish();
+        }
+        line += 1;
+        if line == 1 && first.starts_with('\u{feff}') {
+            first.drain(..'\u{feff}'.len_utf8());
+        }
+        if !first.trim().is_empty() {
+            break;
+        }
+    }
+    let text = first.trim();
+    if text.starts_with(|c: char| c.is_ascii_alphabetic()) {
+        parser.csv_header(text).map_err(at(line))?;
+        let mut csv = csv::ReaderBuilder::new()
+            .has_headers(false)
+            .flexible(true)
+            .trim(csv::Trim::All)
+            .from_reader(reader);
+        let mut record = csv::StringRecord::new();
+        loop {
+            let more = csv
+                .read_record(&mut record)
+                .map_err(|e| match e.into_kind() {
+                    csv::ErrorKind::Io(cause) => io(cause),
+                    other => io(io::Error::new(
+                        io::ErrorKind::InvalidData,
+                        format!("{other:?}"),
+                    )),
+                })?;
+            if !more {
+                break;
+            }
+            let row = line + record.position().map_or(0, |p| p.line() as usize);
+            if record.len() == 1 && record[0].is_empty() {
+                continue;
+            }
+            let fields: Vec<&str> = record.iter().collect();
+            parser.csv_fields(&fields).map_err(at(row))?;
+        }
+        return parser.finish();
+    }
+    parser.line(text).map_err(at(line))?;
+    for next in reader.lines() {
+        line += 1;
+        let next = next.map_err(io)?;
+        parser.line(next.trim_end_matches('\r')).map_err(at(line))?;
     }
     parser.finish()
+}
+
+/// A reader that refuses lines longer than [`MAX_LINE`] bytes.
+struct LineLimit<R> {
+    inner: R,
+    column: usize,
+    line: usize,
+}
+
+impl<R: io::Read> io::Read for LineLimit<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for &b in &buf[..n] {
+            if b == b'\n' {
+                self.column = 0;
+                self.line += 1;
+            } else {
+                self.column += 1;
+                if self.column > MAX_LINE {
+                    return Err(io::Error::new(
+                        io::ErrorKind::InvalidData,
+                        format!(
+                            "line {} is longer than {MAX_LINE} bytes: not a point-set file",
+                            self.line
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(n)
+    }
 }
 
 struct Parser<'a> {
@@ -245,14 +362,12 @@ impl Parser<'_> {
                 self.format = Some(PointFormat::Utk);
                 Ok(())
             }
-            None if text.contains(',') => Err(LineProblem::Header {
-                found: text.to_string(),
-            }),
+            None if text.contains(',') => Err(LineProblem::Header { found: quote(text) }),
             None => {
                 self.format = Some(PointFormat::Utk);
                 self.utk_row(text)
             }
-            Some(PointFormat::Csv) => self.csv_row(text),
+            Some(PointFormat::Csv) => unreachable!("CSV rows go through the csv reader"),
             Some(PointFormat::Utk) if text.starts_with('#') => {
                 self.close_set();
                 Ok(())
@@ -271,17 +386,14 @@ impl Parser<'_> {
                 .enumerate()
                 .all(|(j, n)| *n == format!("x{j}"));
         if !ok {
-            return Err(LineProblem::Header {
-                found: text.to_string(),
-            });
+            return Err(LineProblem::Header { found: quote(text) });
         }
         self.dim = coords.len();
         self.format = Some(PointFormat::Csv);
         Ok(())
     }
 
-    fn csv_row(&mut self, text: &str) -> Result<(), LineProblem> {
-        let fields: Vec<&str> = text.split(',').map(str::trim).collect();
+    fn csv_fields(&mut self, fields: &[&str]) -> Result<(), LineProblem> {
         let expected = self.dim + usize::from(self.set_column);
         if fields.len() != expected {
             return Err(LineProblem::Ragged {
@@ -293,7 +405,7 @@ impl Parser<'_> {
             self.set_number(fields[0])?;
             &fields[1..]
         } else {
-            &fields[..]
+            fields
         };
         let offset = usize::from(self.set_column);
         for (j, f) in coords.iter().enumerate() {
@@ -305,7 +417,7 @@ impl Parser<'_> {
     fn set_number(&mut self, text: &str) -> Result<(), LineProblem> {
         let problem = || LineProblem::SetNumber {
             current: self.set_id,
-            text: text.to_string(),
+            text: quote(text),
         };
         let id: u64 = text.parse().map_err(|_| problem())?;
         match self.set_id {
@@ -357,15 +469,25 @@ impl Parser<'_> {
     }
 }
 
+/// At most 60 characters of `text`, escaped, for an error message.
+fn quote(text: &str) -> String {
+    let short: String = text.chars().take(60).collect();
+    let mut out = short.escape_debug().to_string();
+    if text.chars().count() > 60 {
+        out.push('…');
+    }
+    out
+}
+
 fn coordinate(text: &str, field: usize) -> Result<f64, LineProblem> {
     let v: f64 = text.parse().map_err(|_| LineProblem::NotANumber {
         field,
-        text: text.to_string(),
+        text: quote(text),
     })?;
     if !v.is_finite() {
         return Err(LineProblem::NotFinite {
             field,
-            text: text.to_string(),
+            text: quote(text),
         });
     }
     if !(0.0..1.0).contains(&v) {
@@ -388,26 +510,33 @@ pub fn write_point_sets(
     let dim = sets.first().map_or(0, PointSet::dim);
     let numbered = sets.len() > 1;
     if format == PointFormat::Csv {
-        let names: Vec<String> = (0..dim).map(|j| format!("x{j}")).collect();
-        writeln!(
-            out,
-            "{}{}",
-            if numbered { "set," } else { "" },
-            names.join(",")
-        )?;
+        let mut csv = csv::Writer::from_writer(out);
+        let mut header: Vec<String> = (0..dim).map(|j| format!("x{j}")).collect();
+        if numbered {
+            header.insert(0, "set".into());
+        }
+        csv.write_record(&header)?;
+        let mut row = Vec::with_capacity(dim + 1);
+        for (s, set) in sets.iter().enumerate() {
+            for p in set.points() {
+                row.clear();
+                if numbered {
+                    row.push(s.to_string());
+                }
+                row.extend(p.iter().map(|v| format!("{v:?}")));
+                csv.write_record(&row)?;
+            }
+        }
+        return csv.flush();
     }
     for (s, set) in sets.iter().enumerate() {
-        if format == PointFormat::Utk && s > 0 {
+        if s > 0 {
             writeln!(out, "#")?;
         }
-        let sep = if format == PointFormat::Csv { ',' } else { ' ' };
         for p in set.points() {
-            if format == PointFormat::Csv && numbered {
-                write!(out, "{s},")?;
-            }
             for (j, v) in p.iter().enumerate() {
                 if j > 0 {
-                    write!(out, "{sep}")?;
+                    write!(out, " ")?;
                 }
                 write!(out, "{v:?}")?;
             }

@@ -1,0 +1,132 @@
+//! NumPy `.npy` arrays (the npyz crate), so a Python user loads a point set,
+//! a spectrum or a variance map with one `numpy.load` call: point sets as
+//! float64 `[sets, N, d]`, 2D spectra as float64 `[K, K]` (row = k_y + h,
+//! column = k_x + h, DC at the centre). Point sets are also read back
+//! (float64 or float32, C or Fortran order, `[N, d]` or `[sets, N, d]`).
+
+use std::io::{self, Read, Write};
+
+use npyz::{DType, NpyFile, Order, TypeStr, WriterBuilder};
+
+use crate::points::PointSet;
+
+/// Writes `values` (C order) as a float64 array of `shape`.
+///
+/// # Errors
+/// The writer's I/O error; `InvalidInput` when the shape does not hold the
+/// values.
+pub fn write_npy(out: &mut dyn Write, shape: &[u64], values: &[f64]) -> io::Result<()> {
+    if shape.iter().product::<u64>() != values.len() as u64 {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("shape {shape:?} does not hold {} values", values.len()),
+        ));
+    }
+    let mut writer = npyz::WriteOptions::new()
+        .default_dtype()
+        .shape(shape)
+        .writer(out)
+        .begin_nd()?;
+    writer.extend(values.iter().copied())?;
+    writer.finish()
+}
+
+/// Writes point sets of one size as `[sets, N, d]`.
+///
+/// # Errors
+/// As [`write_npy`]; `InvalidInput` for sets of different sizes.
+pub fn write_point_sets_npy(out: &mut dyn Write, sets: &[PointSet]) -> io::Result<()> {
+    let (n, d) = sets.first().map_or((0, 0), |s| (s.len(), s.dim()));
+    if sets.iter().any(|s| s.len() != n || s.dim() != d) {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "an .npy array needs every set to have the same N and d",
+        ));
+    }
+    let values: Vec<f64> = sets
+        .iter()
+        .flat_map(|s| s.coords().iter().copied())
+        .collect();
+    write_npy(out, &[sets.len() as u64, n as u64, d as u64], &values)
+}
+
+/// The first bytes of every `.npy` file.
+pub const MAGIC: &[u8] = b"\x93NUMPY";
+
+/// Reads point sets from a `.npy` array of shape `[N, d]` (one set) or
+/// `[sets, N, d]`, float64 or float32, every coordinate finite and in
+/// [0, 1).
+///
+/// # Errors
+/// A sentence saying what is wrong: header, dtype, shape, a value (with its
+/// index) or a short read.
+pub fn read_point_sets_npy(reader: impl Read) -> Result<Vec<PointSet>, String> {
+    let file = NpyFile::new(reader).map_err(|e| format!("not a readable .npy array: {e}"))?;
+    let shape = file.shape().to_vec();
+    let (sets, n, d) = match shape[..] {
+        [n, d] => (1, n, d),
+        [s, n, d] => (s, n, d),
+        _ => {
+            return Err(format!(
+                "a point-set array has shape [N, d] or [sets, N, d], found {shape:?}"
+            ));
+        }
+    };
+    if sets == 0 || n == 0 || d == 0 {
+        return Err(format!("the array of shape {shape:?} holds no points"));
+    }
+    let fortran = file.order() == Order::Fortran;
+    let dtype = file.dtype();
+    let values: Vec<f64> = match &dtype {
+        DType::Plain(t) if *t == "<f8".parse::<TypeStr>().expect("valid") => {
+            collect(file.data::<f64>().map_err(|e| e.to_string())?)?
+        }
+        DType::Plain(t) if *t == "<f4".parse::<TypeStr>().expect("valid") => {
+            collect(file.data::<f32>().map_err(|e| e.to_string())?)?
+                .into_iter()
+                .map(f64::from)
+                .collect()
+        }
+        other => {
+            return Err(format!(
+                "the array's dtype is {}, point sets are float64 or float32 (little-endian)",
+                other.descr()
+            ));
+        }
+    };
+    let (sets, n, d) = (sets as usize, n as usize, d as usize);
+    let at = |s: usize, i: usize, j: usize| {
+        if fortran {
+            s + sets * (i + n * j)
+        } else {
+            (s * n + i) * d + j
+        }
+    };
+    (0..sets)
+        .map(|s| {
+            let mut coords = Vec::with_capacity(n * d);
+            for i in 0..n {
+                for j in 0..d {
+                    let v = values[at(s, i, j)];
+                    if !(v.is_finite() && (0.0..1.0).contains(&v)) {
+                        return Err(format!(
+                            "value [{s}, {i}, {j}] is {v}, outside [0, 1) or not finite"
+                        ));
+                    }
+                    coords.push(v);
+                }
+            }
+            PointSet::new(d, coords).map_err(|e| e.to_string())
+        })
+        .collect()
+}
+
+/// Every element of a reader, or the read error (a truncated file).
+fn collect<T, R: Read>(data: npyz::NpyReader<T, R>) -> Result<Vec<T>, String>
+where
+    T: npyz::Deserialize,
+{
+    data.into_iter()
+        .collect::<io::Result<Vec<T>>>()
+        .map_err(|e| format!("the array's data is cut short: {e}"))
+}
