@@ -41,6 +41,7 @@ pub mod quadrature;
 pub mod report;
 pub mod rng;
 pub mod samplers;
+pub mod scene;
 pub mod spectrum;
 pub mod square;
 pub mod variance;

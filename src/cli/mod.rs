@@ -12,6 +12,7 @@ mod pcf;
 mod plot;
 mod predict;
 mod progress;
+mod render;
 mod report;
 mod sample;
 mod source;
@@ -59,6 +60,9 @@ enum Command {
     /// Optimizers: point positions toward a target spectrum.
     #[command(subcommand)]
     Optimize(optimize::OptimizeCommand),
+    /// Render a scene whose pixels are 4D integrands (depth of field, soft
+    /// shadows) with any 4D sampler and per-pixel shears; variance heat maps.
+    Render(render::Args),
     /// Pattern tables for renderers: csv, json, raw f32/f64, C header, with metadata.
     Tables(tables::Args),
     /// The reference integrands (with --list: their parameters).
@@ -102,6 +106,7 @@ pub fn main() -> ExitCode {
             Ok(())
         }
         Command::Optimize(c) => optimize::run(c),
+        Command::Render(a) => render::run(a),
         Command::Tables(a) => tables::run(a),
         Command::Integrands(a) => integrands::run(a),
     };

@@ -205,6 +205,29 @@ fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
     })
 }
 
+/// A grid of values drawn as a heat map with a labelled colour bar.
+#[derive(Debug, Clone)]
+pub struct HeatMap<'a> {
+    /// Title over the picture.
+    pub title: String,
+    /// Values row by row, the first row at the top; NaN draws grey.
+    pub values: &'a [f64],
+    /// Cells per row.
+    pub width: usize,
+    /// The axes' value ranges (left to right, bottom to top).
+    pub x_range: (f64, f64),
+    /// See `x_range`.
+    pub y_range: (f64, f64),
+    /// Horizontal axis label.
+    pub x_label: String,
+    /// Vertical axis label.
+    pub y_label: String,
+    /// Colour-bar label.
+    pub bar_label: String,
+    /// Values mapped to the colour map's ends (clamped beyond).
+    pub colour_range: (f64, f64),
+}
+
 /// Writes a 2D power spectrum as a heat map centred at DC, log10 power in
 /// the viridis colour map with a labelled colour bar (760×640 PNG).
 ///
@@ -215,16 +238,12 @@ fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
 /// [`Error::Write`] naming `path`; a spectrum that is not 2D is refused the
 /// same way.
 pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(), Error> {
-    let fail = |cause| Error::Write {
-        path: path.to_path_buf(),
-        cause,
-    };
     if spectrum.freqs.dim != 2 {
-        return Err(fail(std::io::Error::other(
-            "a spectrum picture needs a 2D spectrum (use --dims)",
-        )));
+        return Err(Error::Write {
+            path: path.to_path_buf(),
+            cause: std::io::Error::other("a spectrum picture needs a 2D spectrum (use --dims)"),
+        });
     }
-    ensure_font();
     let zero = spectrum.freqs.zero_index();
     let logs: Vec<f64> = spectrum
         .power
@@ -238,12 +257,65 @@ pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(),
         (_, hi) if hi.is_finite() => (hi - 1.0, hi + 1.0),
         _ => (-1.0, 1.0),
     };
+    let side = spectrum.freqs.side();
+    // Rows from the top: k_y from +h down to −h.
+    let values: Vec<f64> = (0..side)
+        .rev()
+        .flat_map(|row| (0..side).map(move |col| row * side + col))
+        .map(|idx| match spectrum.power[idx] {
+            _ if idx == zero => hi,
+            p if p <= 0.0 => lo,
+            p => p.log10(),
+        })
+        .collect();
+    let h = spectrum.freqs.half as f64;
+    heatmap_png(
+        &HeatMap {
+            title: title.into(),
+            values: &values,
+            width: side,
+            x_range: (-h - 0.5, h + 0.5),
+            y_range: (-h - 0.5, h + 0.5),
+            x_label: "kx".into(),
+            y_label: "ky".into(),
+            bar_label: "log10 power (N·P_S)".into(),
+            colour_range: (lo, hi),
+        },
+        path,
+    )
+}
+
+/// Writes `map` as a 760×640 PNG (viridis, colour bar on the right),
+/// atomically.
+///
+/// # Errors
+/// [`Error::Write`] naming `path` (also for an empty or ragged grid and for
+/// drawing failures).
+pub fn heatmap_png(map: &HeatMap, path: &Path) -> Result<(), Error> {
+    let fail = |cause| Error::Write {
+        path: path.to_path_buf(),
+        cause,
+    };
+    if map.width == 0 || map.values.is_empty() || map.values.len() % map.width != 0 {
+        return Err(fail(std::io::Error::other(format!(
+            "a heat map of {} values cannot have rows of {}",
+            map.values.len(),
+            map.width
+        ))));
+    }
+    ensure_font();
+    let (lo, hi) = map.colour_range;
     let (w, h) = (760u32, 640u32);
     let mut buf = vec![255u8; (w * h * 3) as usize];
-    let areas = draw_spectrum_frame(spectrum, title, (lo, hi), &mut buf, (w, h)).map_err(fail)?;
-    let (heat, bar) = areas;
-    let side = spectrum.freqs.side();
-    let colour = |v: f64| ViridisRGB::get_color_normalized(v.clamp(lo, hi), lo, hi);
+    let (heat, bar) = draw_heatmap_frame(map, &mut buf, (w, h)).map_err(fail)?;
+    let (cols, rows) = (map.width, map.values.len() / map.width);
+    let colour = |v: f64| {
+        if v.is_nan() {
+            RGBColor(128, 128, 128)
+        } else {
+            ViridisRGB::get_color_normalized(v.clamp(lo, hi), lo, hi)
+        }
+    };
     let mut put = |x: i32, y: i32, c: RGBColor| {
         let o = ((y as u32 * w + x as u32) * 3) as usize;
         buf[o..o + 3].copy_from_slice(&[c.0, c.1, c.2]);
@@ -251,18 +323,11 @@ pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(),
     let (hx, hy) = heat;
     for py in hy.clone() {
         let fy = (py - hy.start) as f64 / (hy.end - hy.start) as f64;
-        let row = side - 1 - ((fy * side as f64) as usize).min(side - 1);
+        let row = ((fy * rows as f64) as usize).min(rows - 1);
         for px in hx.clone() {
             let fx = (px - hx.start) as f64 / (hx.end - hx.start) as f64;
-            let col = ((fx * side as f64) as usize).min(side - 1);
-            let idx = row * side + col;
-            let p = spectrum.power[idx];
-            let v = if idx == zero || p <= 0.0 {
-                if idx == zero { hi } else { lo }
-            } else {
-                p.log10()
-            };
-            put(px, py, colour(v));
+            let col = ((fx * cols as f64) as usize).min(cols - 1);
+            put(px, py, colour(map.values[row * cols + col]));
         }
     }
     let (bx, by) = bar;
@@ -280,32 +345,34 @@ type PixelRange = (std::ops::Range<i32>, std::ops::Range<i32>);
 
 /// Draws axes, labels and colour-bar ticks; returns the pixel ranges of the
 /// heat map and the colour bar, which the caller fills.
-fn draw_spectrum_frame(
-    spectrum: &Spectrum,
-    title: &str,
-    (lo, hi): (f64, f64),
+fn draw_heatmap_frame(
+    map: &HeatMap,
     buf: &mut [u8],
     size: (u32, u32),
 ) -> std::io::Result<(PixelRange, PixelRange)> {
-    let h = spectrum.freqs.half as f64;
     let root = BitMapBackend::with_buffer(buf, size).into_drawing_area();
     root.fill(&WHITE).map_err(draw_error)?;
-    let root = root.titled(title, ("sans-serif", 22)).map_err(draw_error)?;
+    let root = root
+        .titled(&map.title, ("sans-serif", 22))
+        .map_err(draw_error)?;
     let (left, right) = root.split_horizontally(size.0 - 150);
+    let (x0, x1) = map.x_range;
+    let (y0, y1) = map.y_range;
     let mut heat = ChartBuilder::on(&left)
         .margin(12)
         .x_label_area_size(44)
         .y_label_area_size(56)
-        .build_cartesian_2d(-h - 0.5..h + 0.5, -h - 0.5..h + 0.5)
+        .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(draw_error)?;
     heat.configure_mesh()
         .disable_mesh()
-        .x_desc("kx")
-        .y_desc("ky")
+        .x_desc(map.x_label.as_str())
+        .y_desc(map.y_label.as_str())
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
         .draw()
         .map_err(draw_error)?;
+    let (lo, hi) = map.colour_range;
     let mut bar = ChartBuilder::on(&right)
         .margin_top(12)
         .margin_bottom(56)
@@ -316,7 +383,7 @@ fn draw_spectrum_frame(
     bar.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_desc("log10 power (N·P_S)")
+        .y_desc(map.bar_label.as_str())
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 15))
         .draw()

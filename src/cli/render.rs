@@ -1,0 +1,342 @@
+//! `varspec render`: render a scene's pixels as 4D integrands with any 4D
+//! sampler, per-pixel shears from local analysis, and variance heat maps.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+
+use super::{args, progress};
+use varspec::io::write_atomic;
+use varspec::report::plot::{HeatMap, heatmap_png};
+use varspec::samplers;
+use varspec::scene::analysis::{PixelKind, SampleShear};
+use varspec::scene::image::GreyImage;
+use varspec::scene::render::{ShearPolicy, analyse, pixel_shears, render, render_variance};
+use varspec::scene::{BUILTIN_SCENES, Scene};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// A built-in scene (see --list) or a scene file (JSON, docs/scene.md).
+    #[arg(default_value = "dof")]
+    scene: String,
+    /// Any 4D sampler of the registry, with `name:key=value` parameters.
+    #[arg(long, default_value = "umj")]
+    sampler: String,
+    /// Samples per pixel (the sampler's N; umj needs a square).
+    #[arg(long, default_value_t = 16)]
+    spp: usize,
+    /// Shear of each pixel's set: none; analytic (the shear following the
+    /// centre depth's light field); pilot (the best of none and every
+    /// probed depth's shears by --pilots pilot estimates); A (x′ = x + A·u,
+    /// y′ = y + A·v everywhere); warp:K (the footprint warp of slope K
+    /// everywhere).
+    #[arg(long, default_value = "none", allow_hyphen_values = true)]
+    shear: String,
+    /// Pilot estimates per candidate shear (--shear pilot).
+    #[arg(long, default_value_t = 8)]
+    pilots: usize,
+    /// Seed: the same seed gives the same image for any thread count.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Independent renders; 2 or more also give the per-pixel variance.
+    #[arg(long, default_value_t = 1)]
+    renders: usize,
+    /// Tone-mapped PNG of the (mean) image (default out/render/SCENE.png).
+    #[arg(short = 'o', long = "output")]
+    output: Option<PathBuf>,
+    /// Multiplier before tone mapping.
+    #[arg(long, default_value_t = 1.0)]
+    exposure: f64,
+    /// Float image (PFM) of the (mean) image.
+    #[arg(long)]
+    pfm: Option<PathBuf>,
+    /// Heat map PNG of log10 per-pixel variance, with a colour bar.
+    #[arg(long)]
+    variance_png: Option<PathBuf>,
+    /// Float image (PFM) of the per-pixel variance.
+    #[arg(long)]
+    variance_pfm: Option<PathBuf>,
+    /// Reference image (PFM) for the MSE in the summary.
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Summary JSON: variance statistics, MSE, time.
+    #[arg(long)]
+    summary: Option<PathBuf>,
+    /// Per-pixel analysis CSV: px,py,kind,depth,kappa,a,b.
+    #[arg(long)]
+    analysis: Option<PathBuf>,
+    /// Heat map PNG of the light-field slope κ each pixel's shear follows.
+    #[arg(long)]
+    shear_png: Option<PathBuf>,
+    /// Sampler parameter key=value (repeatable).
+    #[arg(long = "param", value_parser = args::key_value)]
+    params: Vec<(String, String)>,
+    /// List the built-in scenes.
+    #[arg(long)]
+    list: bool,
+}
+
+pub fn run(a: Args) -> anyhow::Result<()> {
+    if a.list {
+        for (name, about, _) in BUILTIN_SCENES {
+            println!("{name}\n    {about}");
+        }
+        return Ok(());
+    }
+    if !(a.exposure.is_finite() && a.exposure > 0.0) {
+        bail!("--exposure {}: expected a positive number", a.exposure);
+    }
+    if a.renders == 0 {
+        bail!("--renders must be at least 1");
+    }
+    let policy = match a.shear.as_str() {
+        "none" => ShearPolicy::None,
+        "analytic" => ShearPolicy::Analytic,
+        "pilot" => ShearPolicy::Pilot { pilots: a.pilots },
+        text => {
+            let (warp, number) = match text.strip_prefix("warp:") {
+                Some(rest) => (true, rest),
+                None => (false, text),
+            };
+            match number.parse::<f64>() {
+                Ok(s) if s.is_finite() && warp => ShearPolicy::Global(SampleShear::Warp(s)),
+                Ok(s) if s.is_finite() => ShearPolicy::Global(SampleShear::Position([s, s])),
+                _ => bail!(
+                    "--shear {text}: expected none, analytic, pilot, a finite number A or warp:K"
+                ),
+            }
+        }
+    };
+    let scene = Scene::load(&a.scene)?;
+    let sampler = samplers::build(&a.sampler, a.spp, Some(4), &a.params).with_context(|| {
+        format!(
+            "--sampler {}: rendering needs a 4D sampler (x, y on the pixel, u, v on the lens or light)",
+            a.sampler
+        )
+    })?;
+    let [w, h] = scene.camera().resolution();
+    let start = Instant::now();
+    let analysis = analyse(&scene);
+    let shears = pixel_shears(&scene, sampler.as_ref(), policy, &analysis, a.seed)?;
+    let bar = progress::bar(a.renders as u64, &format!("render {}", scene.name()));
+    let (image, variance) = if a.renders >= 2 {
+        let maps = render_variance(
+            &scene,
+            sampler.as_ref(),
+            &shears,
+            a.seed,
+            a.renders,
+            &|| bar.inc(1),
+        )?;
+        (maps.mean, Some(maps.variance))
+    } else {
+        let img = render(&scene, sampler.as_ref(), &shears, a.seed, 0)?;
+        bar.inc(1);
+        (img, None)
+    };
+    bar.finish_and_clear();
+    let seconds = start.elapsed().as_secs_f64();
+    let output = a.output.clone().unwrap_or_else(|| {
+        let stem = std::path::Path::new(&a.scene)
+            .file_stem()
+            .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from(format!("out/render/{stem}.png"))
+    });
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    image.write_png(a.exposure, &output)?;
+    if let Some(path) = &a.pfm {
+        image.write_pfm(path)?;
+    }
+    let reference = match &a.reference {
+        Some(path) => {
+            let r = GreyImage::read_pfm(path).map_err(anyhow::Error::msg)?;
+            if (r.width, r.height) != (w, h) {
+                bail!(
+                    "{}: the reference is {}×{}, the scene renders {w}×{h}",
+                    path.display(),
+                    r.width,
+                    r.height
+                );
+            }
+            Some(r)
+        }
+        None => None,
+    };
+    let title = format!(
+        "{}: {} at {} spp, shear {}",
+        scene.name(),
+        a.sampler,
+        a.spp,
+        a.shear
+    );
+    if let Some(var) = &variance {
+        if let Some(path) = &a.variance_pfm {
+            var.write_pfm(path)?;
+        }
+        if let Some(path) = &a.variance_png {
+            variance_png(
+                var,
+                &format!("variance over {} renders, {title}", a.renders),
+                path,
+            )?;
+        }
+    } else if a.variance_png.is_some() || a.variance_pfm.is_some() {
+        bail!("a variance needs --renders 2 or more");
+    }
+    if let Some(path) = &a.analysis {
+        write_atomic(path, |out| {
+            writeln!(out, "px,py,kind,depth,kappa,shear_form,a,b")?;
+            for (i, (p, s)) in analysis.iter().zip(&shears).enumerate() {
+                let [sa, sb] = s.amounts();
+                writeln!(
+                    out,
+                    "{},{},{},{:?},{:?},{},{sa:?},{sb:?}",
+                    i % w,
+                    i / w,
+                    p.kind.name(),
+                    p.depth,
+                    p.kappa,
+                    s.form()
+                )?;
+            }
+            Ok(())
+        })?;
+    }
+    if let Some(path) = &a.shear_png {
+        let values: Vec<f64> = shears.iter().map(SampleShear::slope).collect();
+        let lim = values.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-9);
+        heatmap_png(
+            &HeatMap {
+                title: format!("light-field slope the shear follows, {title}"),
+                values: &values,
+                width: w,
+                x_range: (0.0, w as f64),
+                y_range: (0.0, h as f64),
+                x_label: "pixel x".into(),
+                y_label: "pixel y (from the bottom)".into(),
+                bar_label: "κ (pixels per unit u)".into(),
+                colour_range: (-lim, lim),
+            },
+            path,
+        )?;
+    }
+    let summary = summary_json(
+        &a,
+        &scene,
+        &analysis,
+        variance.as_ref(),
+        &image,
+        reference.as_ref(),
+        seconds,
+    );
+    if let Some(path) = &a.summary {
+        write_atomic(path, |out| writeln!(out, "{summary:#}"))?;
+    }
+    eprintln!(
+        "{title}: {w}×{h}, {} render(s) in {seconds:.2} s ({:.1} M samples/s){}",
+        a.renders,
+        (w * h * a.spp * a.renders) as f64 / seconds / 1e6,
+        match &variance {
+            Some(v) => format!(", mean pixel variance {:.4e}", mean(&v.pixels)),
+            None => String::new(),
+        }
+    );
+    eprintln!("wrote {}", output.display());
+    Ok(())
+}
+
+fn mean(v: &[f64]) -> f64 {
+    varspec::variance::sum::sum(v.iter().copied()) / v.len() as f64
+}
+
+/// The `q` quantile (nearest rank) of `v`.
+fn quantile(v: &[f64], q: f64) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1]
+}
+
+fn summary_json(
+    a: &Args,
+    scene: &Scene,
+    analysis: &[varspec::scene::analysis::PixelAnalysis],
+    variance: Option<&GreyImage>,
+    image: &GreyImage,
+    reference: Option<&GreyImage>,
+    seconds: f64,
+) -> serde_json::Value {
+    let count = |k: PixelKind| analysis.iter().filter(|p| p.kind == k).count();
+    let mut out = serde_json::json!({
+        "scene": scene.name(),
+        "sampler": a.sampler,
+        "spp": a.spp,
+        "shear": a.shear,
+        "seed": a.seed,
+        "renders": a.renders,
+        "resolution": scene.camera().resolution(),
+        "triangles": scene.geometry().triangle_count(),
+        "pixels": {
+            "background": count(PixelKind::Background),
+            "single": count(PixelKind::Single),
+            "edge": count(PixelKind::Edge),
+        },
+        "seconds": seconds,
+    });
+    if let Some(v) = variance {
+        out["variance"] = serde_json::json!({
+            "mean": mean(&v.pixels),
+            "median": quantile(&v.pixels, 0.5),
+            "p95": quantile(&v.pixels, 0.95),
+        });
+    }
+    if let Some(r) = reference {
+        // Mean over renders of (estimate − reference)²: the variance term
+        // (R − 1)/R · s² plus the squared error of the mean, per pixel.
+        let renders = a.renders as f64;
+        let mse: Vec<f64> = image
+            .pixels
+            .iter()
+            .zip(&r.pixels)
+            .enumerate()
+            .map(|(i, (m, r))| {
+                let s2 = variance.map_or(0.0, |v| v.pixels[i]);
+                (renders - 1.0) / renders * s2 + (m - r) * (m - r)
+            })
+            .collect();
+        out["mse_against_reference"] = serde_json::json!(mean(&mse));
+    }
+    out
+}
+
+fn variance_png(var: &GreyImage, title: &str, path: &std::path::Path) -> anyhow::Result<()> {
+    let logs: Vec<f64> = var
+        .pixels
+        .iter()
+        .map(|&v| if v > 0.0 { v.log10() } else { f64::NAN })
+        .collect();
+    let finite: Vec<f64> = logs.iter().copied().filter(|v| v.is_finite()).collect();
+    let (lo, hi) = if finite.is_empty() {
+        (-1.0, 0.0)
+    } else {
+        let hi = quantile(&finite, 0.999);
+        (quantile(&finite, 0.01).max(hi - 6.0), hi)
+    };
+    heatmap_png(
+        &HeatMap {
+            title: title.into(),
+            values: &logs,
+            width: var.width,
+            x_range: (0.0, var.width as f64),
+            y_range: (0.0, var.height as f64),
+            x_label: "pixel x".into(),
+            y_label: "pixel y (from the bottom)".into(),
+            bar_label: "log10 variance (grey: 0)".into(),
+            colour_range: (lo, hi.max(lo + 1e-9)),
+        },
+        path,
+    )?;
+    Ok(())
+}

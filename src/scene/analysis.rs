@@ -1,0 +1,236 @@
+//! Per-pixel local analysis: which depths a pixel's light field holds, and
+//! the shear that follows it ("model only what a scene needs").
+//!
+//! A pixel seeing one depth d has a light field sheared by
+//! κ = (F − d)/d · 2A/s (see [`super::camera`]): its spectrum is a line and
+//! the sample shear a = b = −κ aligns the sampler's empty region with it.
+//! A pixel whose lens rays meet two or more depths (an occlusion edge) holds
+//! two sheared lines, the seed's double wedge, which no single shear
+//! aligns; a pixel whose rays all miss sees the constant background.
+
+use super::Scene;
+use super::description::IntegrandKind;
+use crate::points::{PointSet, wrap01};
+use crate::rng::PREV_ONE;
+
+/// What the probes of one pixel found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PixelKind {
+    /// Every probe missed: a constant integrand.
+    Background,
+    /// One depth (within [`DEPTH_TOLERANCE`]): one sheared line.
+    Single,
+    /// Two or more depths, or hits and misses: a double wedge.
+    Edge,
+}
+
+impl PixelKind {
+    /// Lower-case name for tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            PixelKind::Background => "background",
+            PixelKind::Single => "single",
+            PixelKind::Edge => "edge",
+        }
+    }
+}
+
+/// Relative depth difference above which two probes see different depths.
+pub const DEPTH_TOLERANCE: f64 = 0.05;
+
+/// Probe positions along each lens axis (3 × 3 rays per pixel).
+const PROBES: [f64; 3] = [0.1, 0.5, 0.9];
+
+/// The local analysis of one pixel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PixelAnalysis {
+    /// What the probes found.
+    pub kind: PixelKind,
+    /// Depth seen by the centre ray (NaN on a miss).
+    pub depth: f64,
+    /// Its light-field shear κ (pixels per unit of u; 0 on a miss or for a
+    /// pinhole).
+    pub kappa: f64,
+    /// The distinct shears κ of the depths the probes met, nearest first.
+    pub kappas: Vec<f64>,
+}
+
+impl PixelAnalysis {
+    /// The analytic sample shear of the centre depth
+    /// ([`SampleShear::following`]); none for the background and for the
+    /// soft-shadow integrand, whose (u, v) are on the light, not the lens.
+    pub fn shear(&self) -> SampleShear {
+        SampleShear::following(self.kappa)
+    }
+}
+
+/// A transformation of a 4D set (x, y, u, v) that keeps every point uniform
+/// in [0, 1)^4 (so estimates stay unbiased) and aligns it with a light
+/// field g(x + κu, y + κv), in one of two forms.
+///
+/// `Position` is the torus shear of the seed and the shear search
+/// (Singh & Jarosz 2017): x′ = x + a·u mod 1 with a = −κ makes x′ + κu
+/// equal x up to a whole number. On the torus that whole number does not
+/// matter; on a pixel's footprint it does, because g is not periodic: the
+/// argument t = x + κu spans 1 + |κ| pixels and the wrapped points land at
+/// random whole offsets (measured: no gain on defocused pixels).
+///
+/// `Warp` is the same alignment made exact on the footprint: a
+/// measure-preserving map of each (position, lens) pair that draws the
+/// argument t = x + κu from its own distribution (the trapezoid, the sum of
+/// U[0, 1) and U[0, κ)) by inverting its CDF at the set's lens coordinate,
+/// and the position given t uniformly on its allowed interval from the
+/// set's position coordinate. The pixel integral becomes ∫ g(t) w(t) dt
+/// sampled by the lens pattern's stratification (2D multi-jitter for umj),
+/// for any κ.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SampleShear {
+    /// x′ = x + a·u, y′ = y + b·v (mod 1).
+    Position([f64; 2]),
+    /// The footprint warp of a light field with shear κ on both axes.
+    Warp(f64),
+}
+
+impl SampleShear {
+    /// No shear.
+    pub const NONE: SampleShear = SampleShear::Position([0.0, 0.0]);
+
+    /// The transformation that follows a light field of shear κ: the warp.
+    pub fn following(kappa: f64) -> SampleShear {
+        SampleShear::Warp(kappa)
+    }
+
+    /// `position` or `warp`.
+    pub fn form(&self) -> &'static str {
+        match self {
+            SampleShear::Position(_) => "position",
+            SampleShear::Warp(_) => "warp",
+        }
+    }
+
+    /// The two numbers: (a, b) of a position shear, (κ, κ) of a warp.
+    pub fn amounts(&self) -> [f64; 2] {
+        match *self {
+            SampleShear::Position(s) => s,
+            SampleShear::Warp(k) => [k, k],
+        }
+    }
+
+    /// The light-field slope κ it follows (−a of a position shear).
+    pub fn slope(&self) -> f64 {
+        match *self {
+            SampleShear::Position([a, _]) => -a,
+            SampleShear::Warp(k) => k,
+        }
+    }
+
+    /// The transformed set.
+    ///
+    /// # Panics
+    /// On a set that is not 4D (callers check the sampler).
+    pub fn apply(&self, set: PointSet) -> PointSet {
+        let coords = match *self {
+            SampleShear::Position([a, b]) if a == 0.0 && b == 0.0 => return set,
+            SampleShear::Position([a, b]) => set
+                .points()
+                .flat_map(|p| [wrap01(p[0] + a * p[2]), wrap01(p[1] + b * p[3]), p[2], p[3]])
+                .collect(),
+            SampleShear::Warp(kappa) => set
+                .points()
+                .flat_map(|p| {
+                    let (x, u) = footprint_warp(kappa, p[2], p[0]);
+                    let (y, v) = footprint_warp(kappa, p[3], p[1]);
+                    [x, y, u, v]
+                })
+                .collect(),
+        };
+        PointSet::new(4, coords).expect("transformed coordinates lie in [0, 1)")
+    }
+}
+
+/// (x, u) uniform on [0, 1)² from (ξ₁, ξ₂) uniform on [0, 1)², with
+/// t = x + κu = T⁻¹(ξ₁) for T the CDF of t, and x = ξ₂ along the interval
+/// of positions that t allows. A bijection that preserves measure, so
+/// stratification of ξ₁ becomes stratification of the light field's
+/// argument.
+pub fn footprint_warp(kappa: f64, xi1: f64, xi2: f64) -> (f64, f64) {
+    let k = kappa.abs();
+    let clamp = |v: f64| v.clamp(0.0, PREV_ONE);
+    if k == 0.0 {
+        return (xi1, xi2);
+    }
+    // t = x + k·w with x ~ U[0, 1), w ~ U[0, 1): trapezoid on [0, 1 + k]
+    // with ramps of width a = min(1, k), plateau height 1/b, b = max(1, k).
+    let (a, b) = (k.min(1.0), k.max(1.0));
+    let ramp = a / (2.0 * b);
+    let t = if xi1 < ramp {
+        (2.0 * a * b * xi1).sqrt()
+    } else if xi1 < 1.0 - ramp {
+        b * xi1 + 0.5 * a
+    } else {
+        a + b - (2.0 * a * b * (1.0 - xi1)).sqrt()
+    };
+    let (lo, hi) = ((t - k).max(0.0), t.min(1.0));
+    let x = clamp(lo + xi2 * (hi - lo));
+    let w = clamp((t - x) / k);
+    // κ < 0: t − k = x − k·u with u = 1 − w.
+    let u = if kappa > 0.0 { w } else { clamp(1.0 - w) };
+    (x, u)
+}
+
+/// Probes pixel (px, py) with 3 × 3 rays through its centre from points
+/// spread over the lens (one ray for a pinhole or the soft-shadow
+/// integrand).
+pub fn analyse_pixel(scene: &Scene, px: usize, py: usize) -> PixelAnalysis {
+    let camera = scene.camera();
+    let lens = scene.integrand() == IntegrandKind::Lens && scene.has_aperture();
+    let probes: Vec<[f64; 2]> = if lens {
+        PROBES
+            .iter()
+            .flat_map(|&u| PROBES.iter().map(move |&v| [u, v]))
+            .collect()
+    } else {
+        vec![[0.5, 0.5]]
+    };
+    let depth_of = |[u, v]: [f64; 2]| {
+        let ray = camera.ray(px, py, [0.5, 0.5, u, v]);
+        scene
+            .geometry()
+            .closest(ray.origin, ray.direction, 0.0)
+            .map(|hit| camera.depth(hit.point))
+    };
+    let centre = depth_of([0.5, 0.5]);
+    let mut depths: Vec<Option<f64>> = probes.iter().map(|&p| depth_of(p)).collect();
+    depths.sort_by(|a, b| match (a, b) {
+        (Some(x), Some(y)) => x.total_cmp(y),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => std::cmp::Ordering::Equal,
+    });
+    // Cluster sorted depths: a gap above the tolerance starts a new depth.
+    let mut clusters: Vec<f64> = Vec::new();
+    let mut missed = false;
+    for d in &depths {
+        match d {
+            Some(d) => match clusters.last() {
+                Some(&last) if (d - last) <= DEPTH_TOLERANCE * last => {}
+                _ => clusters.push(*d),
+            },
+            None => missed = true,
+        }
+    }
+    let kind = match (clusters.len(), missed) {
+        (0, _) => PixelKind::Background,
+        (1, false) => PixelKind::Single,
+        _ => PixelKind::Edge,
+    };
+    let kappa_of = |d: f64| {
+        if lens { camera.shear_at_depth(d) } else { 0.0 }
+    };
+    PixelAnalysis {
+        kind,
+        depth: centre.unwrap_or(f64::NAN),
+        kappa: centre.map_or(0.0, kappa_of),
+        kappas: clusters.into_iter().map(kappa_of).collect(),
+    }
+}

@@ -1,0 +1,398 @@
+//! Scene files: JSON read with serde, every field checked with an error that
+//! names it (docs/formats.md, "Scene file"). Grey-scale radiance throughout:
+//! the analysis works on one scalar integrand per pixel.
+
+use serde::Deserialize;
+
+/// A whole scene as written in its file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// The thin-lens camera.
+    pub camera: CameraFile,
+    /// Triangle meshes with their materials.
+    pub objects: Vec<ObjectFile>,
+    /// Area lights (may be empty: then only `ambient` lights the scene).
+    #[serde(default)]
+    pub lights: Vec<LightFile>,
+    /// Constant light from every direction, added to the area lights.
+    #[serde(default)]
+    pub ambient: f64,
+    /// What (u, v) of the pixel integrand f(x, y, u, v) samples: the lens
+    /// (depth of field) or the first light (soft shadows).
+    pub integrand: IntegrandKind,
+}
+
+/// The 4D pixel integrand's (u, v) dimensions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IntegrandKind {
+    /// (u, v) on the lens: depth of field; lights are lit from their centre.
+    Lens,
+    /// (u, v) on the light: soft shadows through a pinhole camera.
+    Light,
+}
+
+/// A thin-lens camera with a square aperture.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraFile {
+    /// Image width and height in pixels.
+    pub resolution: [usize; 2],
+    /// Horizontal field of view in degrees, in (0, 180).
+    pub fov_degrees: f64,
+    /// Centre of the lens.
+    pub position: [f64; 3],
+    /// A point the camera looks at.
+    pub look_at: [f64; 3],
+    /// Up direction (need not be orthogonal to the view).
+    #[serde(default = "default_up")]
+    pub up: [f64; 3],
+    /// Distance F of the plane in focus, along the view axis.
+    pub focal_distance: f64,
+    /// Half the side of the square lens (0: a pinhole).
+    pub aperture: f64,
+}
+
+fn default_up() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// One mesh.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectFile {
+    /// Built-in shape: `quad` ([−1, 1]² in the xy plane, normal +z),
+    /// `box` ([−1, 1]³) or `sphere` (unit radius, tessellated).
+    pub shape: ShapeKind,
+    /// Scale per axis, applied first.
+    #[serde(default = "unit_scale")]
+    pub scale: [f64; 3],
+    /// Rotation about the y axis in degrees, applied second.
+    #[serde(default)]
+    pub rotate_y_degrees: f64,
+    /// Translation, applied last.
+    #[serde(default)]
+    pub translate: [f64; 3],
+    /// Sphere tessellation: subdivisions of an icosahedron (0 to 7).
+    #[serde(default = "default_subdivisions")]
+    pub subdivisions: u32,
+    /// The diffuse material.
+    pub material: MaterialFile,
+}
+
+fn unit_scale() -> [f64; 3] {
+    [1.0; 3]
+}
+
+fn default_subdivisions() -> u32 {
+    3
+}
+
+/// Built-in mesh shapes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShapeKind {
+    /// Two triangles.
+    Quad,
+    /// Twelve triangles.
+    Box,
+    /// A subdivided icosahedron.
+    Sphere,
+}
+
+/// A diffuse material: albedo in [0, 1], constant or a solid texture in the
+/// object's frame (its translation and rotation, world units: scaling the
+/// object does not stretch the texture), so its bandwidth is known.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, tag = "texture", rename_all = "snake_case")]
+pub enum MaterialFile {
+    /// One albedo.
+    Constant {
+        /// The albedo.
+        albedo: f64,
+    },
+    /// A 3D checkerboard of cells `period`/2 wide.
+    Checker {
+        /// Period in object units.
+        period: f64,
+        /// Albedo of the dark cells.
+        low: f64,
+        /// Albedo of the light cells.
+        high: f64,
+    },
+    /// Stripes across the object's x axis.
+    Stripes {
+        /// Period in object units.
+        period: f64,
+        /// Albedo of the dark stripes.
+        low: f64,
+        /// Albedo of the light stripes.
+        high: f64,
+    },
+}
+
+/// An emitting square or disk, one-sided, facing `normal`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightFile {
+    /// `square` or `disk`.
+    pub shape: LightShape,
+    /// Centre.
+    pub centre: [f64; 3],
+    /// The side it emits towards.
+    pub normal: [f64; 3],
+    /// Side (square) or diameter (disk).
+    pub size: f64,
+    /// Emitted radiance.
+    pub radiance: f64,
+}
+
+/// Area-light shapes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LightShape {
+    /// A square.
+    Square,
+    /// A disk (sampled by the concentric map, Shirley & Chiu 1997).
+    Disk,
+}
+
+/// What is wrong with a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// Unreadable file.
+    #[error("{path}: {cause}")]
+    Io {
+        /// The file.
+        path: String,
+        /// Why.
+        cause: std::io::Error,
+    },
+    /// Malformed JSON or a field of the wrong type (serde's message names
+    /// the field, line and column).
+    #[error("{source_name}: {message}")]
+    Syntax {
+        /// File or built-in name.
+        source_name: String,
+        /// serde_json's message.
+        message: String,
+    },
+    /// A value out of its range.
+    #[error("{source_name}: {field} = {value}: {expected}")]
+    Field {
+        /// File or built-in name.
+        source_name: String,
+        /// Path of the field, e.g. `objects[2].scale`.
+        field: String,
+        /// The value found.
+        value: String,
+        /// What is accepted.
+        expected: String,
+    },
+    /// No built-in scene and no file of that name.
+    #[error("no scene `{name}`: neither a built-in scene ({known}) nor a file")]
+    Unknown {
+        /// The name given.
+        name: String,
+        /// The built-in names.
+        known: String,
+    },
+}
+
+/// The largest image side accepted (pixels).
+pub const MAX_SIDE: usize = 16384;
+
+impl SceneFile {
+    /// Parses and checks a scene; `source_name` names it in errors.
+    ///
+    /// # Errors
+    /// [`SceneError::Syntax`] or [`SceneError::Field`].
+    pub fn parse(text: &str, source_name: &str) -> Result<SceneFile, SceneError> {
+        let scene: SceneFile = serde_json::from_str(text).map_err(|e| SceneError::Syntax {
+            source_name: source_name.into(),
+            message: e.to_string(),
+        })?;
+        scene.check(source_name)?;
+        Ok(scene)
+    }
+
+    fn check(&self, source_name: &str) -> Result<(), SceneError> {
+        let bad = |field: String, value: String, expected: &str| SceneError::Field {
+            source_name: source_name.into(),
+            field,
+            value,
+            expected: expected.into(),
+        };
+        let c = &self.camera;
+        for (axis, &side) in ["width", "height"].iter().zip(&c.resolution) {
+            if side == 0 || side > MAX_SIDE {
+                return Err(bad(
+                    format!("camera.resolution ({axis})"),
+                    side.to_string(),
+                    &format!("an integer from 1 to {MAX_SIDE}"),
+                ));
+            }
+        }
+        if !(c.fov_degrees > 0.0 && c.fov_degrees < 180.0) {
+            return Err(bad(
+                "camera.fov_degrees".into(),
+                c.fov_degrees.to_string(),
+                "a number of degrees in (0, 180)",
+            ));
+        }
+        finite3("camera.position", &c.position).map_err(|(f, v)| bad(f, v, FINITE))?;
+        finite3("camera.look_at", &c.look_at).map_err(|(f, v)| bad(f, v, FINITE))?;
+        finite3("camera.up", &c.up).map_err(|(f, v)| bad(f, v, FINITE))?;
+        let view = sub(c.look_at, c.position);
+        if norm(view) < 1e-9 {
+            return Err(bad(
+                "camera.look_at".into(),
+                format!("{:?}", c.look_at),
+                "a point other than camera.position",
+            ));
+        }
+        if norm(cross(view, c.up)) < 1e-9 * norm(view) * norm(c.up) {
+            return Err(bad(
+                "camera.up".into(),
+                format!("{:?}", c.up),
+                "a direction not parallel to the view (look_at − position)",
+            ));
+        }
+        if !(c.focal_distance.is_finite() && c.focal_distance > 0.0) {
+            return Err(bad(
+                "camera.focal_distance".into(),
+                c.focal_distance.to_string(),
+                "a positive distance",
+            ));
+        }
+        if !(c.aperture.is_finite() && c.aperture >= 0.0) {
+            return Err(bad(
+                "camera.aperture".into(),
+                c.aperture.to_string(),
+                "a half-side ≥ 0 (0: a pinhole)",
+            ));
+        }
+        if self.objects.is_empty() {
+            return Err(bad("objects".into(), "[]".into(), "at least one object"));
+        }
+        for (i, o) in self.objects.iter().enumerate() {
+            let field = |name: &str| format!("objects[{i}].{name}");
+            finite3(&field("translate"), &o.translate).map_err(|(f, v)| bad(f, v, FINITE))?;
+            if o.scale.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+                return Err(bad(
+                    field("scale"),
+                    format!("{:?}", o.scale),
+                    "three positive scale factors",
+                ));
+            }
+            if !o.rotate_y_degrees.is_finite() {
+                return Err(bad(
+                    field("rotate_y_degrees"),
+                    o.rotate_y_degrees.to_string(),
+                    FINITE,
+                ));
+            }
+            if o.subdivisions > 7 {
+                return Err(bad(
+                    field("subdivisions"),
+                    o.subdivisions.to_string(),
+                    "0 to 7 (7 is 327,680 triangles)",
+                ));
+            }
+            o.material.check().map_err(|(name, value, expected)| {
+                bad(field(&format!("material.{name}")), value, expected)
+            })?;
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            let field = |name: &str| format!("lights[{i}].{name}");
+            finite3(&field("centre"), &l.centre).map_err(|(f, v)| bad(f, v, FINITE))?;
+            if norm(l.normal) < 1e-9 || l.normal.iter().any(|v| !v.is_finite()) {
+                return Err(bad(
+                    field("normal"),
+                    format!("{:?}", l.normal),
+                    "a non-zero direction",
+                ));
+            }
+            if !(l.size.is_finite() && l.size > 0.0) {
+                return Err(bad(field("size"), l.size.to_string(), "a positive size"));
+            }
+            if !(l.radiance.is_finite() && l.radiance >= 0.0) {
+                return Err(bad(
+                    field("radiance"),
+                    l.radiance.to_string(),
+                    "a radiance ≥ 0",
+                ));
+            }
+        }
+        if !(self.ambient.is_finite() && self.ambient >= 0.0) {
+            return Err(bad(
+                "ambient".into(),
+                self.ambient.to_string(),
+                "a radiance ≥ 0",
+            ));
+        }
+        match self.integrand {
+            IntegrandKind::Light if self.lights.is_empty() => Err(bad(
+                "integrand".into(),
+                "\"light\"".into(),
+                "a scene with at least one light (soft shadows sample the first)",
+            )),
+            IntegrandKind::Light if c.aperture > 0.0 => Err(bad(
+                "camera.aperture".into(),
+                c.aperture.to_string(),
+                "0 for the \"light\" integrand (its (u, v) sample the light, not the lens)",
+            )),
+            _ => Ok(()),
+        }
+    }
+}
+
+impl MaterialFile {
+    fn check(&self) -> Result<(), (&'static str, String, &'static str)> {
+        let albedo = |name, v: f64| {
+            if (0.0..=1.0).contains(&v) {
+                Ok(())
+            } else {
+                Err((name, v.to_string(), "an albedo in [0, 1]"))
+            }
+        };
+        match *self {
+            MaterialFile::Constant { albedo: a } => albedo("albedo", a),
+            MaterialFile::Checker { period, low, high }
+            | MaterialFile::Stripes { period, low, high } => {
+                if !(period.is_finite() && period > 0.0) {
+                    return Err(("period", period.to_string(), "a positive period"));
+                }
+                albedo("low", low)?;
+                albedo("high", high)
+            }
+        }
+    }
+}
+
+const FINITE: &str = "finite numbers";
+
+fn finite3(field: &str, v: &[f64; 3]) -> Result<(), (String, String)> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err((field.into(), format!("{v:?}")))
+    }
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}

@@ -1,0 +1,128 @@
+//! Grey images: linear radiance in PFM (Portable Float Map, the format
+//! pbrt and most HDR tools read), tone-mapped PNG for looking at.
+
+use std::io::{self, Write};
+use std::path::Path;
+
+use crate::Error;
+use crate::io::write_atomic;
+
+/// A grey image, rows from the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GreyImage {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// `width · height` values, row by row from the top.
+    pub pixels: Vec<f64>,
+}
+
+impl GreyImage {
+    /// Writes PFM: header `Pf`, `width height`, `-1` (little-endian), then
+    /// f32 rows from the bottom up, as the format specifies.
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming `path`.
+    pub fn write_pfm(&self, path: &Path) -> Result<(), Error> {
+        write_atomic(path, |w| self.pfm(w))
+    }
+
+    fn pfm(&self, w: &mut dyn Write) -> io::Result<()> {
+        write!(w, "Pf\n{} {}\n-1.0\n", self.width, self.height)?;
+        for row in self.pixels.chunks_exact(self.width).rev() {
+            for &v in row {
+                w.write_all(&(v as f32).to_le_bytes())?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads a grey PFM written by [`Self::write_pfm`] or another tool
+    /// (either byte order).
+    ///
+    /// # Errors
+    /// A sentence naming what is wrong with the file.
+    pub fn read_pfm(path: &Path) -> Result<GreyImage, String> {
+        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let bad = |what: &str| format!("{}: not a grey PFM image: {what}", path.display());
+        // Three whitespace-separated header tokens after `Pf`, then one
+        // whitespace byte, then the data.
+        let mut fields = Vec::new();
+        let mut i = 0;
+        while fields.len() < 4 {
+            while i < bytes.len() && bytes[i].is_ascii_whitespace() {
+                i += 1;
+            }
+            let start = i;
+            while i < bytes.len() && !bytes[i].is_ascii_whitespace() {
+                i += 1;
+            }
+            if start == i || i - start > 32 {
+                return Err(bad("header cut short"));
+            }
+            fields.push(String::from_utf8_lossy(&bytes[start..i]).into_owned());
+        }
+        i += 1;
+        if fields[0] != "Pf" {
+            return Err(bad(&format!("magic `{}`, expected `Pf`", fields[0])));
+        }
+        let parse = |s: &str| {
+            s.parse::<usize>()
+                .ok()
+                .filter(|&v| (1..=1 << 16).contains(&v))
+        };
+        let (Some(width), Some(height)) = (parse(&fields[1]), parse(&fields[2])) else {
+            return Err(bad("size is not two integers from 1 to 65536"));
+        };
+        let scale: f64 = fields[3]
+            .parse()
+            .map_err(|_| bad("scale is not a number"))?;
+        let data = bytes.get(i..).unwrap_or_default();
+        if data.len() != 4 * width * height {
+            return Err(bad(&format!(
+                "{} data bytes where {width}×{height} needs {}",
+                data.len(),
+                4 * width * height
+            )));
+        }
+        let value = |c: &[u8]| {
+            let b = [c[0], c[1], c[2], c[3]];
+            f64::from(if scale < 0.0 {
+                f32::from_le_bytes(b)
+            } else {
+                f32::from_be_bytes(b)
+            })
+        };
+        let rows: Vec<Vec<f64>> = data
+            .chunks_exact(4 * width)
+            .map(|row| row.chunks_exact(4).map(value).collect())
+            .collect();
+        Ok(GreyImage {
+            width,
+            height,
+            pixels: rows.into_iter().rev().flatten().collect(),
+        })
+    }
+
+    /// Writes an 8-bit PNG: radiance × `exposure`, clamped to [0, 1], sRGB
+    /// encoded.
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming `path`.
+    pub fn write_png(&self, exposure: f64, path: &Path) -> Result<(), Error> {
+        let encode = |v: f64| {
+            let l = (v * exposure).clamp(0.0, 1.0);
+            let s = if l <= 0.003_130_8 {
+                12.92 * l
+            } else {
+                1.055 * l.powf(1.0 / 2.4) - 0.055
+            };
+            (s * 255.0 + 0.5) as u8
+        };
+        let bytes: Vec<u8> = self.pixels.iter().flat_map(|&v| [encode(v); 3]).collect();
+        let img = ::image::RgbImage::from_raw(self.width as u32, self.height as u32, bytes)
+            .expect("buffer matches size");
+        crate::report::png::save_png(&img, path)
+    }
+}

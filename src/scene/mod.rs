@@ -1,0 +1,253 @@
+//! The scene: a small obvhs ray tracer whose pixels are the 4D integrands of
+//! the analysis (docs/scene.md). f(x, y, u, v) has (x, y) on the pixel's
+//! footprint and (u, v) on the lens (depth of field) or on the first light
+//! (soft shadows); [`Scene::radiance`] evaluates it.
+
+pub mod analysis;
+pub mod camera;
+pub mod description;
+pub mod geometry;
+pub mod image;
+pub mod render;
+
+use camera::Camera;
+use description::{IntegrandKind, LightFile, LightShape, MaterialFile, SceneError, SceneFile};
+use geometry::{Geometry, Placement, dot};
+
+/// The built-in scenes: name, what it shows, its JSON.
+pub const BUILTIN_SCENES: [(&str, &str, &str); 3] = [
+    (
+        "dof",
+        "depth of field: a checkered box in focus between a defocused striped sphere and a \
+         checkered wall",
+        include_str!("../../scenes/dof.json"),
+    ),
+    (
+        "shadows-square",
+        "soft shadows of a box on a floor under a square light",
+        include_str!("../../scenes/shadows-square.json"),
+    ),
+    (
+        "shadows-disk",
+        "the same under a disk light of the same area",
+        include_str!("../../scenes/shadows-disk.json"),
+    ),
+];
+
+/// A scene ready to render.
+pub struct Scene {
+    name: String,
+    file: SceneFile,
+    camera: Camera,
+    geometry: Geometry,
+    placements: Vec<Placement>,
+    lights: Vec<Light>,
+}
+
+/// An area light with its orthonormal frame.
+struct Light {
+    shape: LightShape,
+    centre: [f64; 3],
+    normal: [f64; 3],
+    tangent: [f64; 3],
+    bitangent: [f64; 3],
+    size: f64,
+    radiance: f64,
+}
+
+impl Light {
+    fn new(l: &LightFile) -> Light {
+        let n = description::norm(l.normal);
+        let normal = l.normal.map(|c| c / n);
+        // Any vector not parallel to the normal gives the frame.
+        let helper = if normal[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let t = description::cross(helper, normal);
+        let tn = description::norm(t);
+        let tangent = t.map(|c| c / tn);
+        let bitangent = description::cross(normal, tangent);
+        Light {
+            shape: l.shape,
+            centre: l.centre,
+            normal,
+            tangent,
+            bitangent,
+            size: l.size,
+            radiance: l.radiance,
+        }
+    }
+
+    fn area(&self) -> f64 {
+        match self.shape {
+            LightShape::Square => self.size * self.size,
+            LightShape::Disk => std::f64::consts::PI * 0.25 * self.size * self.size,
+        }
+    }
+
+    /// The point of the light at (u, v) ∈ [0, 1)², uniform in area: the
+    /// square directly, the disk by the concentric map (Shirley & Chiu
+    /// 1997), which keeps strata compact.
+    fn point(&self, u: f64, v: f64) -> [f64; 3] {
+        let (a, b) = match self.shape {
+            LightShape::Square => (self.size * (u - 0.5), self.size * (v - 0.5)),
+            LightShape::Disk => {
+                let (p, q) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+                let (r, phi) = if p == 0.0 && q == 0.0 {
+                    (0.0, 0.0)
+                } else if p.abs() > q.abs() {
+                    (p, std::f64::consts::FRAC_PI_4 * (q / p))
+                } else {
+                    (
+                        q,
+                        std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (p / q),
+                    )
+                };
+                let r = 0.5 * self.size * r;
+                (r * phi.cos(), r * phi.sin())
+            }
+        };
+        std::array::from_fn(|k| self.centre[k] + a * self.tangent[k] + b * self.bitangent[k])
+    }
+}
+
+/// Offsets that keep secondary rays off the surface they leave.
+const RAY_EPSILON: f64 = 1e-4;
+
+impl Scene {
+    /// A built-in scene by name, or a scene file by path.
+    ///
+    /// # Errors
+    /// [`SceneError`] naming the file and field.
+    pub fn load(name_or_path: &str) -> Result<Scene, SceneError> {
+        if let Some((name, _, json)) = BUILTIN_SCENES.iter().find(|s| s.0 == name_or_path) {
+            return Scene::from_text(json, name);
+        }
+        let path = std::path::Path::new(name_or_path);
+        if !path.exists() {
+            return Err(SceneError::Unknown {
+                name: name_or_path.into(),
+                known: BUILTIN_SCENES.map(|s| s.0).join(", "),
+            });
+        }
+        let text = std::fs::read_to_string(path).map_err(|cause| SceneError::Io {
+            path: name_or_path.into(),
+            cause,
+        })?;
+        Scene::from_text(&text, name_or_path)
+    }
+
+    /// A scene from JSON text; `name` names it in errors and reports.
+    ///
+    /// # Errors
+    /// [`SceneError::Syntax`] or [`SceneError::Field`].
+    pub fn from_text(text: &str, name: &str) -> Result<Scene, SceneError> {
+        let file = SceneFile::parse(text, name)?;
+        Ok(Scene {
+            name: name.into(),
+            camera: Camera::new(&file.camera),
+            geometry: Geometry::build(&file.objects),
+            placements: file.objects.iter().map(Placement::of).collect(),
+            lights: file.lights.iter().map(Light::new).collect(),
+            file,
+        })
+    }
+
+    /// The scene's name (built-in name or path).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The geometry.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+
+    /// Whether the lens has an area (aperture > 0).
+    pub fn has_aperture(&self) -> bool {
+        self.file.camera.aperture > 0.0
+    }
+
+    /// What (u, v) sample.
+    pub fn integrand(&self) -> IntegrandKind {
+        self.file.integrand
+    }
+
+    /// The pixel integrand f(x, y, u, v) of pixel (px, py), `p` in
+    /// [0, 1)^4: the radiance along the camera ray. Lens integrand: (u, v)
+    /// on the lens, each light seen as a point at its centre (shadowed);
+    /// light integrand: a pinhole ray and (u, v) on the first light, one
+    /// sample of each light's direct illumination (its area times L_e
+    /// cosθ cosθ′ / (π r²), shadowed). Misses see the ambient radiance.
+    pub fn radiance(&self, px: usize, py: usize, p: [f64; 4]) -> f64 {
+        let lens = self.file.integrand == IntegrandKind::Lens;
+        let ray_point = if lens { p } else { [p[0], p[1], 0.5, 0.5] };
+        let ray = self.camera.ray(px, py, ray_point);
+        let Some(hit) = self.geometry.closest(ray.origin, ray.direction, 0.0) else {
+            return self.file.ambient;
+        };
+        let albedo = self.albedo(hit.object, hit.point);
+        let mut irradiance = self.file.ambient;
+        for light in &self.lights {
+            let at = if lens {
+                light.centre
+            } else {
+                light.point(p[2], p[3])
+            };
+            irradiance += self.direct(light, at, hit.point, hit.normal);
+        }
+        albedo * irradiance
+    }
+
+    /// One-sample direct illumination from `light` through its point `at`,
+    /// as irradiance/π times the light's area (so ambient and lights add).
+    fn direct(&self, light: &Light, at: [f64; 3], point: [f64; 3], normal: [f64; 3]) -> f64 {
+        let to = description::sub(at, point);
+        let r2 = dot(to, to);
+        let r = r2.sqrt();
+        let dir = to.map(|c| c / r);
+        let cos_surface = dot(normal, dir);
+        let cos_light = -dot(light.normal, dir);
+        if cos_surface <= 0.0 || cos_light <= 0.0 {
+            return 0.0;
+        }
+        let origin: [f64; 3] = std::array::from_fn(|k| point[k] + RAY_EPSILON * normal[k]);
+        if !self
+            .geometry
+            .unoccluded(origin, dir, RAY_EPSILON, r - RAY_EPSILON)
+        {
+            return 0.0;
+        }
+        light.radiance * light.area() * cos_surface * cos_light / (std::f64::consts::PI * r2)
+    }
+
+    /// The material's albedo at a world point of object `object`. Solid
+    /// textures have their cells centred on the object's origin, so faces
+    /// through the origin or at whole multiples of a cell do not fall on a
+    /// cell boundary.
+    fn albedo(&self, object: usize, point: [f64; 3]) -> f64 {
+        let q = self.placements[object].frame(point);
+        let cell = |x: f64, period: f64| (2.0 * x / period + 0.5).floor() as i64;
+        match self.file.objects[object].material {
+            MaterialFile::Constant { albedo } => albedo,
+            MaterialFile::Checker { period, low, high } => {
+                let parity = cell(q[0], period) + cell(q[1], period) + cell(q[2], period);
+                if parity.rem_euclid(2) == 0 { high } else { low }
+            }
+            MaterialFile::Stripes { period, low, high } => {
+                if cell(q[0], period).rem_euclid(2) == 0 {
+                    high
+                } else {
+                    low
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,278 @@
+//! Rendering with any 4D sampler of the registry: each pixel draws its own
+//! realization, seeded by (seed, render, pixel), so images are identical for
+//! any thread count; the pixel value is the sample mean of f(x, y, u, v),
+//! optionally after shearing the set by a per-pixel (a, b) (x′ = x + a·u,
+//! y′ = y + b·v mod 1, which keeps every point uniform: the estimate stays
+//! unbiased for any shear).
+
+use rayon::prelude::*;
+
+use super::Scene;
+use super::analysis::{PixelAnalysis, PixelKind, SampleShear, analyse_pixel};
+use super::image::GreyImage;
+use crate::rng::set_rng;
+use crate::samplers::{Sampler, SamplerError};
+use crate::variance::sum::NeumaierSum;
+
+/// How each pixel's sample set is sheared.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ShearPolicy {
+    /// No shear.
+    None,
+    /// One shear for every pixel.
+    Global(SampleShear),
+    /// The shear following the depth the pixel's centre ray sees
+    /// ([`SampleShear::following`]).
+    Analytic,
+    /// Per pixel, the candidate (none, and the position shear and the warp
+    /// of every depth the probes met) with the lowest sample variance over
+    /// `pilots` pilot estimates drawn from a stream independent of the
+    /// render's.
+    Pilot {
+        /// Pilot estimates per candidate.
+        pilots: usize,
+    },
+}
+
+/// What is wrong with a render request.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// The sampler cannot make 4D sets.
+    #[error(
+        "rendering needs a 4D sampler (x, y on the pixel, u, v on the {on}); this one is {dim}D"
+    )]
+    NotFourD {
+        /// Its dimension.
+        dim: usize,
+        /// Lens or light.
+        on: &'static str,
+    },
+    /// A sampler failure.
+    #[error(transparent)]
+    Sampler(#[from] SamplerError),
+    /// Zero renders or pilots.
+    #[error("{what} must be at least {min}")]
+    Count {
+        /// Which count.
+        what: &'static str,
+        /// Its minimum.
+        min: usize,
+    },
+}
+
+/// The stream of pixel `pixel` in render `render` (pilots use renders from
+/// [`PILOT_STREAM`] on).
+fn pixel_stream(render: u64, pixel: usize) -> u64 {
+    (render << 32) | pixel as u64
+}
+
+/// First render index of the pilot streams: far from any render count.
+const PILOT_STREAM: u64 = 1 << 30;
+
+/// The per-pixel analysis of the whole image, row by row from the top.
+pub fn analyse(scene: &Scene) -> Vec<PixelAnalysis> {
+    let [w, h] = scene.camera().resolution();
+    (0..w * h)
+        .into_par_iter()
+        .map(|i| analyse_pixel(scene, i % w, i / w))
+        .collect()
+}
+
+/// The (a, b) of every pixel under `policy`.
+///
+/// # Errors
+/// [`RenderError`] from the pilot renders.
+pub fn pixel_shears(
+    scene: &Scene,
+    sampler: &dyn Sampler,
+    policy: ShearPolicy,
+    analysis: &[PixelAnalysis],
+    seed: u64,
+) -> Result<Vec<SampleShear>, RenderError> {
+    check_sampler(scene, sampler)?;
+    let w = scene.camera().resolution()[0];
+    match policy {
+        ShearPolicy::None => Ok(vec![SampleShear::NONE; analysis.len()]),
+        ShearPolicy::Global(s) => Ok(vec![s; analysis.len()]),
+        ShearPolicy::Analytic => Ok(analysis.iter().map(PixelAnalysis::shear).collect()),
+        ShearPolicy::Pilot { pilots } => {
+            if pilots < 2 {
+                return Err(RenderError::Count {
+                    what: "pilot estimates per candidate",
+                    min: 2,
+                });
+            }
+            analysis
+                .par_iter()
+                .enumerate()
+                .map(|(i, a)| {
+                    if a.kind == PixelKind::Background {
+                        return Ok(SampleShear::NONE);
+                    }
+                    let mut best = (SampleShear::NONE, f64::INFINITY);
+                    let candidates = std::iter::once(SampleShear::NONE).chain(
+                        a.kappas
+                            .iter()
+                            .filter(|k| **k != 0.0)
+                            .flat_map(|&k| [SampleShear::Position([-k, -k]), SampleShear::Warp(k)]),
+                    );
+                    for shear in candidates {
+                        let mut values = Vec::with_capacity(pilots);
+                        for p in 0..pilots {
+                            let stream = pixel_stream(PILOT_STREAM + p as u64, i);
+                            values.push(estimate(
+                                scene,
+                                sampler,
+                                shear,
+                                i % w,
+                                i / w,
+                                seed,
+                                stream,
+                            )?);
+                        }
+                        let v = sample_variance(&values);
+                        if v < best.1 {
+                            best = (shear, v);
+                        }
+                    }
+                    Ok(best.0)
+                })
+                .collect()
+        }
+    }
+}
+
+fn check_sampler(scene: &Scene, sampler: &dyn Sampler) -> Result<(), RenderError> {
+    if sampler.dim() == 4 {
+        return Ok(());
+    }
+    Err(RenderError::NotFourD {
+        dim: sampler.dim(),
+        on: match scene.integrand() {
+            super::description::IntegrandKind::Lens => "lens",
+            super::description::IntegrandKind::Light => "light",
+        },
+    })
+}
+
+/// One pixel's estimate: the compensated mean of f over one sheared set.
+fn estimate(
+    scene: &Scene,
+    sampler: &dyn Sampler,
+    shear: SampleShear,
+    px: usize,
+    py: usize,
+    seed: u64,
+    stream: u64,
+) -> Result<f64, RenderError> {
+    let set = shear.apply(sampler.sample(&mut set_rng(seed, stream))?);
+    let mut sum = NeumaierSum::default();
+    for p in set.points() {
+        sum.add(scene.radiance(px, py, [p[0], p[1], p[2], p[3]]));
+    }
+    Ok(sum.value() / set.len() as f64)
+}
+
+/// Render number `render` with the per-pixel shears.
+///
+/// # Errors
+/// [`RenderError`].
+pub fn render(
+    scene: &Scene,
+    sampler: &dyn Sampler,
+    shears: &[SampleShear],
+    seed: u64,
+    render: u64,
+) -> Result<GreyImage, RenderError> {
+    check_sampler(scene, sampler)?;
+    let [width, height] = scene.camera().resolution();
+    let pixels = (0..width * height)
+        .into_par_iter()
+        .map(|i| {
+            estimate(
+                scene,
+                sampler,
+                shears[i],
+                i % width,
+                i / width,
+                seed,
+                pixel_stream(render, i),
+            )
+        })
+        .collect::<Result<Vec<f64>, RenderError>>()?;
+    Ok(GreyImage {
+        width,
+        height,
+        pixels,
+    })
+}
+
+/// Per-pixel mean and unbiased variance over `renders` independent renders.
+#[derive(Debug, Clone)]
+pub struct VarianceMaps {
+    /// Mean of the renders.
+    pub mean: GreyImage,
+    /// Sample variance of each pixel's estimate (R − 1 in the denominator).
+    pub variance: GreyImage,
+    /// R.
+    pub renders: usize,
+}
+
+/// Renders `renders` times (renders 0 … R−1 of `seed`) and accumulates the
+/// per-pixel mean and variance (Welford's update: no difference of large
+/// sums). `progress` is called once per render.
+///
+/// # Errors
+/// [`RenderError`]; fewer than 2 renders.
+pub fn render_variance(
+    scene: &Scene,
+    sampler: &dyn Sampler,
+    shears: &[SampleShear],
+    seed: u64,
+    renders: usize,
+    progress: &dyn Fn(),
+) -> Result<VarianceMaps, RenderError> {
+    if renders < 2 {
+        return Err(RenderError::Count {
+            what: "renders for a variance",
+            min: 2,
+        });
+    }
+    let mut mean: Option<GreyImage> = None;
+    let mut m2: Vec<f64> = Vec::new();
+    for r in 0..renders {
+        let img = render(scene, sampler, shears, seed, r as u64)?;
+        let n = (r + 1) as f64;
+        match &mut mean {
+            None => {
+                m2 = vec![0.0; img.pixels.len()];
+                mean = Some(img);
+            }
+            Some(mean) => {
+                for ((m, s), x) in mean.pixels.iter_mut().zip(&mut m2).zip(&img.pixels) {
+                    let delta = x - *m;
+                    *m += delta / n;
+                    *s += delta * (x - *m);
+                }
+            }
+        }
+        progress();
+    }
+    let mean = mean.expect("renders ≥ 2");
+    let variance = GreyImage {
+        width: mean.width,
+        height: mean.height,
+        pixels: m2.iter().map(|s| s / (renders - 1) as f64).collect(),
+    };
+    Ok(VarianceMaps {
+        mean,
+        variance,
+        renders,
+    })
+}
+
+fn sample_variance(values: &[f64]) -> f64 {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0)
+}

@@ -1,0 +1,160 @@
+//! `varspec render` as users run it: identical images for any thread count,
+//! every output written, scene files refused with the field named.
+
+mod common;
+use common::{assert_fails, temp_dir, varspec_with};
+
+#[test]
+fn renders_are_identical_on_one_and_two_threads_and_write_every_output() {
+    let dir = temp_dir("render");
+    let run = |threads: &str, tag: &str| {
+        let p = |name: &str| {
+            dir.join(format!("{tag}-{name}"))
+                .to_str()
+                .unwrap()
+                .to_owned()
+        };
+        let out = varspec_with(
+            &[
+                "render",
+                "dof",
+                "--spp",
+                "4",
+                "--renders",
+                "2",
+                "--shear",
+                "analytic",
+                "-o",
+                &p("img.png"),
+                "--pfm",
+                &p("img.pfm"),
+                "--variance-pfm",
+                &p("var.pfm"),
+                "--variance-png",
+                &p("var.png"),
+                "--analysis",
+                &p("an.csv"),
+                "--summary",
+                &p("sum.json"),
+                "--shear-png",
+                &p("shear.png"),
+            ],
+            Some(threads),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (
+            std::fs::read(p("img.pfm")).unwrap(),
+            std::fs::read(p("var.pfm")).unwrap(),
+        )
+    };
+    assert_eq!(
+        run("1", "one"),
+        run("2", "two"),
+        "thread count changed the image"
+    );
+    let pfm = std::fs::read(dir.join("one-img.pfm")).unwrap();
+    assert!(pfm.starts_with(b"Pf\n256 256\n-1.0\n"));
+    assert_eq!(pfm.len(), 16 + 4 * 256 * 256);
+    let csv = std::fs::read_to_string(dir.join("one-an.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 256 * 256);
+    assert!(
+        csv.contains(",single,") && csv.contains(",edge,"),
+        "the dof scene has both"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("one-sum.json")).unwrap()).unwrap();
+    assert!(summary["variance"]["mean"].as_f64().unwrap() > 0.0);
+    for png in ["img.png", "var.png", "shear.png"] {
+        let bytes = std::fs::read(dir.join(format!("one-{png}"))).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG"), "{png}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_scenes_and_requests_are_refused_with_the_field_named() {
+    let dir = temp_dir("badscene");
+    let base =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/dof.json")).unwrap();
+    let cases = [
+        (
+            "\"fov_degrees\": 40",
+            "\"fov_degrees\": 180",
+            "camera.fov_degrees = 180",
+        ),
+        (
+            "\"aperture\": 0.06",
+            "\"aperture\": -1",
+            "camera.aperture = -1",
+        ),
+        (
+            "\"resolution\": [256, 256]",
+            "\"resolution\": [0, 256]",
+            "camera.resolution (width) = 0",
+        ),
+        (
+            "\"period\": 0.25",
+            "\"period\": 0",
+            "objects[1].material.period = 0",
+        ),
+        (
+            "\"high\": 0.85",
+            "\"high\": 1.5",
+            "objects[0].material.high = 1.5",
+        ),
+        (
+            "\"scale\": [6, 6, 1]",
+            "\"scale\": [6, 0, 1]",
+            "objects[0].scale",
+        ),
+        (
+            "\"subdivisions\": 4",
+            "\"subdivisions\": 9",
+            "objects[2].subdivisions = 9",
+        ),
+        (
+            "\"shape\": \"quad\"",
+            "\"shape\": \"torus\"",
+            "unknown variant `torus`",
+        ),
+        (
+            "\"integrand\": \"lens\"",
+            "\"integrand\": \"light\"",
+            "at least one light",
+        ),
+        (
+            "\"look_at\": [0, 0, -1]",
+            "\"look_at\": [0, 0, 0]",
+            "camera.look_at",
+        ),
+        (
+            "\"ambient\": 1.0",
+            "\"ambiant\": 1.0",
+            "unknown field `ambiant`",
+        ),
+    ];
+    for (from, to, phrase) in cases {
+        assert!(base.contains(from), "{from}");
+        let path = dir.join("bad.json");
+        std::fs::write(&path, base.replacen(from, to, 1)).unwrap();
+        assert_fails(&["render", path.to_str().unwrap(), "--spp", "4"], phrase);
+    }
+    assert_fails(&["render", "nosuchscene"], "neither a built-in scene (dof,");
+    assert_fails(
+        &["render", "dof", "--sampler", "cmj"],
+        "rendering needs a 4D sampler",
+    );
+    assert_fails(
+        &["render", "dof", "--shear", "steep"],
+        "--shear steep: expected",
+    );
+    assert_fails(
+        &["render", "dof", "--variance-png", "v.png"],
+        "--renders 2 or more",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
