@@ -116,9 +116,143 @@ fn bad_requests_fail_with_a_specific_message() {
             ],
             "/nonexistent-dir/x.csv",
         ),
+        (
+            vec![
+                "optimize",
+                "shear",
+                "-n",
+                "64",
+                "--integrand",
+                "defocus:c=0.5",
+                "--range",
+                "1e300",
+            ],
+            "--range a positive number up to 64 (got 1e300)",
+        ),
+        (
+            vec![
+                "optimize",
+                "shear",
+                "-n",
+                "64",
+                "--integrand",
+                "defocus:c=0.5",
+                "--range",
+                "inf",
+            ],
+            "(got inf)",
+        ),
+        (
+            vec!["sample", "random", "-n", "4", "-o", "."],
+            "it is a folder; give a file name inside it",
+        ),
+        (
+            vec!["sample", "random", "-n", "4", "-o", "somedir/"],
+            "it is a folder",
+        ),
     ] {
         common::assert_fails(&args, phrase);
     }
+}
+
+#[test]
+fn a_search_that_finds_nothing_better_says_so() {
+    // No defocus: the answer is no shear, and the report must not claim a gain.
+    let out = common::varspec(&[
+        "optimize",
+        "shear",
+        "-n",
+        "64",
+        "--integrand",
+        "defocus:c=0",
+        "--realizations",
+        "0",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("(unchanged)"), "{text}");
+    assert!(text.contains("shear a = 0.0000, b = 0.0000"), "{text}");
+}
+
+#[test]
+fn outputs_are_checked_before_the_work_starts() {
+    // Each of these would run for minutes before writing; the bad output
+    // must be refused at once, before any progress is made.
+    for args in [
+        vec![
+            "optimize",
+            "points",
+            "-n",
+            "4096",
+            "--target",
+            "blue",
+            "--iters",
+            "100000",
+            "-o",
+            "/nodir/x.csv",
+        ],
+        vec![
+            "optimize",
+            "points",
+            "-n",
+            "16",
+            "--target",
+            "blue",
+            "-o",
+            "ok.csv",
+            "--report",
+            "/nodir/r.json",
+        ],
+        vec![
+            "spectrum",
+            "--sampler",
+            "random",
+            "-n",
+            "64",
+            "--csv",
+            "ok.csv",
+            "--png",
+            "/nodir/x.png",
+        ],
+        vec![
+            "render",
+            "dof",
+            "--spp",
+            "1024",
+            "--renders",
+            "64",
+            "--summary",
+            "/nodir/s.json",
+        ],
+        vec![
+            "tables",
+            "--sampler",
+            "cmj",
+            "-n",
+            "64",
+            "--format",
+            "csv",
+            "-o",
+            "/nodir/t.csv",
+        ],
+    ] {
+        let start = std::time::Instant::now();
+        common::assert_fails(&args, "the folder /nodir does not exist");
+        // Not a timing goal: a generous bound that only a run doing the
+        // work first (minutes) would exceed.
+        assert!(
+            start.elapsed().as_secs() < 20,
+            "{args:?} did the work first"
+        );
+    }
+    assert!(
+        !std::path::Path::new("ok.csv").exists(),
+        "a partial output was written"
+    );
 }
 
 #[test]

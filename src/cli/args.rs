@@ -42,3 +42,14 @@ pub struct DrawArgs {
     #[arg(long = "param", value_parser = key_value)]
     pub params: Vec<(String, String)>,
 }
+
+/// Checks every output before any work starts (a missing folder, a folder
+/// given as a file), so a long run does not end in a failed write.
+pub fn check_outputs<'a>(
+    paths: impl IntoIterator<Item = Option<&'a std::path::Path>>,
+) -> anyhow::Result<()> {
+    for path in paths.into_iter().flatten() {
+        varspec::io::check_output(path)?;
+    }
+    Ok(())
+}

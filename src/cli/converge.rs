@@ -63,6 +63,7 @@ struct Point {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
     let f = integrands::parse(&a.integrand)?;
     if a.ns.len() < 2 {
         bail!("--n needs at least two values to fit a slope");

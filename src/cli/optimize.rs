@@ -9,7 +9,7 @@ use clap::Subcommand;
 use rayon::prelude::*;
 use serde_json::json;
 
-use super::progress;
+use super::{args, progress};
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::rng::set_rng;
@@ -139,6 +139,12 @@ enum DomainArg {
 }
 
 fn points(a: PointsArgs) -> anyhow::Result<()> {
+    args::check_outputs([
+        Some(a.output.as_path()),
+        a.report.as_deref(),
+        a.curve.as_deref(),
+        a.curve_png.as_deref(),
+    ])?;
     if a.sets == 0 {
         bail!("--sets must be at least 1");
     }
@@ -513,13 +519,14 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
 fn shear(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::integrands;
     use varspec::optimize::shear::{
-        ObjectiveOptions, SENSITIVITY_STEP, ShearObjective, Sheared, search_shear, shear_set,
-        spectral_start,
+        MAX_SHEAR_RANGE, ObjectiveOptions, SENSITIVITY_STEP, ShearObjective, Sheared, search_shear,
+        shear_set, spectral_start,
     };
     use varspec::report::plot::spectrum_png;
     use varspec::samplers::Sampler;
     use varspec::spectrum::{FrequencyBox, Method, expected_power};
     use varspec::variance::{VarianceError, empirical_shifting};
+    args::check_outputs([a.output.as_deref()])?;
 
     let f = integrands::parse(&a.integrand)?;
     if f.dim() != 4 {
@@ -529,9 +536,10 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             f.dim()
         );
     }
-    if a.realizations == 1 || !(a.range.is_finite() && a.range > 0.0) {
+    if a.realizations == 1 || !(a.range.is_finite() && a.range > 0.0 && a.range <= MAX_SHEAR_RANGE)
+    {
         bail!(
-            "--realizations must be 0 (no check) or at least 2, and --range a finite positive number (got {})",
+            "--realizations must be 0 (no check) or at least 2, and --range a positive number up to {MAX_SHEAR_RANGE} (got {:?})",
             a.range
         );
     }
@@ -648,7 +656,9 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             },
             found.unsheared.value,
             found.optimum.value,
-            if ratio <= 1.0 {
+            if ratio == 1.0 {
+                "unchanged".to_string()
+            } else if ratio < 1.0 {
                 format!("{:.2}x lower", 1.0 / ratio)
             } else {
                 format!("{ratio:.2}x higher")

@@ -31,6 +31,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
     let source = a.source.resolve(None)?;
     let bar = progress::bar(source.count() as u64, "pcf");
     let sets = (0..source.count())

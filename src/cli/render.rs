@@ -108,6 +108,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }
         }
     };
+    args::check_outputs([
+        a.output.as_deref(),
+        a.pfm.as_deref(),
+        a.variance_png.as_deref(),
+        a.variance_pfm.as_deref(),
+        a.summary.as_deref(),
+        a.analysis.as_deref(),
+        a.shear_png.as_deref(),
+    ])?;
     let scene = Scene::load(&a.scene)?;
     let sampler = samplers::build(&a.sampler, a.spp, Some(4), &a.params).with_context(|| {
         format!(

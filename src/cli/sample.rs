@@ -84,6 +84,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.sampler.or(a.sampler_flag).expect("clap requires one"),
         a.n.expect("clap requires it"),
     );
+    args::check_outputs([a.output.as_deref()])?;
     if a.sets == 0 {
         bail!("--sets must be at least 1");
     }

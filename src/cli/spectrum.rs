@@ -57,6 +57,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.res < 2 {
         bail!("--res {}: the box |k| < K/2 needs K >= 2", a.res);
     }
+    super::args::check_outputs([
+        a.csv.as_deref(),
+        a.npy.as_deref(),
+        a.radial.as_deref(),
+        a.png.as_deref(),
+        a.radial_png.as_deref(),
+    ])?;
     let method = match a.method {
         MethodArg::Fast => Method::Fast { tolerance: a.tol },
         MethodArg::Direct => Method::Direct,

@@ -56,6 +56,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    super::args::check_outputs([Some(a.output.as_path())])?;
     let (sets, source) = match (&a.sampler, &a.from) {
         (Some(name), _) => {
             let n = a.n.context("--sampler needs -n")?;

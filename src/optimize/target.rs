@@ -8,7 +8,7 @@
 //!   a CCVT-like blue-noise target (the centre only changes the phase);
 //! * `power:A`: W = |k|^-A;
 //! * `radial:FILE.csv`: W(|k|) linearly interpolated from columns `k,weight`
-//!   (0 beyond the table).
+//!   (0 beyond the table; scaled so that the largest weight is 1).
 
 use std::path::Path;
 
@@ -202,10 +202,17 @@ fn read_radial(path: &Path) -> Result<Vec<(f64, f64)>, String> {
         }
         table.push((k, w));
     }
-    if table.is_empty() {
-        return Err(format!("{}: no rows", path.display()));
+    let largest = table.iter().fold(0.0f64, |m, &(_, w)| m.max(w));
+    if table.is_empty() || largest == 0.0 {
+        return Err(format!(
+            "{}: no positive weight: nothing to optimize",
+            path.display()
+        ));
     }
-    Ok(table)
+    // The optimum does not depend on the scale of W; dividing by the
+    // largest weight keeps the loss and its gradient finite (weights near
+    // f64::MAX would overflow them).
+    Ok(table.into_iter().map(|(k, w)| (k, w / largest)).collect())
 }
 
 #[cfg(test)]
@@ -262,6 +269,18 @@ mod tests {
             Ok(Target::Integrand(_))
         ));
         assert!(Target::parse("disk:r=0.7").is_err());
+    }
+
+    #[test]
+    fn radial_tables_are_scaled_to_a_largest_weight_of_one() {
+        let dir = std::env::temp_dir().join(format!("varspec-radial-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("w.csv");
+        std::fs::write(&path, "k,weight\n1,1e308\n10,5e307\n30,0\n").unwrap();
+        assert_eq!(read_radial(&path).unwrap(), vec![(1.0, 1.0), (10.0, 0.5), (30.0, 0.0)]);
+        std::fs::write(&path, "k,weight\n1,0\n2,0\n").unwrap();
+        assert!(read_radial(&path).unwrap_err().contains("no positive weight"));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -91,6 +91,11 @@ impl CostFunction for Joint<'_, '_> {
     }
 }
 
+/// The widest shear range searched: a shear of 64 moves x by 64 periods
+/// across the lens, far beyond any light field's slope; the line scans cost
+/// O(range) evaluations.
+pub const MAX_SHEAR_RANGE: f64 = 64.0;
+
 /// Searches (a, b) in [−`range`, `range`]² from the spectral `start`.
 ///
 /// # Errors
@@ -101,9 +106,9 @@ pub fn search_shear(
     start: &SpectralStart,
     range: f64,
 ) -> Result<ShearResult, OptimizeError> {
-    if !(range.is_finite() && range > 0.0) {
+    if !(range.is_finite() && range > 0.0 && range <= MAX_SHEAR_RANGE) {
         return Err(OptimizeError::Option(format!(
-            "the shear range must be a finite positive number, not {range}"
+            "the shear range must be a positive number up to {MAX_SHEAR_RANGE}, not {range}"
         )));
     }
     let clamp = |s: [f64; 2]| [s[0].clamp(-range, range), s[1].clamp(-range, range)];
