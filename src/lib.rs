@@ -33,6 +33,7 @@ pub mod error;
 pub mod experiment;
 pub mod integrands;
 pub mod io;
+pub mod memory;
 pub mod neighbours;
 pub mod optimize;
 pub mod points;

@@ -143,6 +143,44 @@ fn bad_requests_fail_with_a_specific_message() {
             "(got inf)",
         ),
         (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "64",
+                "--integrand",
+                "disk:r=0.3,r=0.2",
+            ],
+            "`r` is given twice",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "64",
+                "--integrand",
+                "disk:r=0.3",
+                "--res",
+                "2",
+            ],
+            "--res 2: the Fourier box |k| < K/2 needs K >= 3",
+        ),
+        (
+            vec![
+                "pcf",
+                "--sampler",
+                "jitter",
+                "-n",
+                "64",
+                "--bandwidth",
+                "1e-300",
+            ],
+            "--bandwidth 1e-300: the kernel's σ",
+        ),
+        (
             vec!["sample", "random", "-n", "4", "-o", "."],
             "it is a folder; give a file name inside it",
         ),
@@ -153,6 +191,49 @@ fn bad_requests_fail_with_a_specific_message() {
     ] {
         common::assert_fails(&args, phrase);
     }
+}
+
+#[test]
+fn a_file_source_refuses_the_sampler_options_it_would_ignore() {
+    let dir = temp_dir("filesrc");
+    let path = dir.join("j.csv");
+    let file = path.to_str().unwrap();
+    assert!(
+        varspec(&["sample", "jitter", "-n", "64", "--sets", "2", "-o", file])
+            .status
+            .success()
+    );
+    for extra in [
+        vec!["-n", "100"],
+        vec!["--sets", "4"],
+        vec!["--param", "m=2"],
+        vec!["-d", "2"],
+    ] {
+        let mut args = vec!["predict", file, "--integrand", "disk:r=0.3"];
+        args.extend(extra);
+        common::assert_fails(&args, "apply to --sampler");
+    }
+    let mut tables = vec![
+        "tables", "--from", file, "--format", "csv", "--sets", "3", "-o",
+    ];
+    let out = dir.join("t.csv");
+    tables.push(out.to_str().unwrap());
+    common::assert_fails(&tables, "apply to --sampler");
+    // One set: the spatial form's standard error is unknown, not 0.
+    let one = varspec(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "64",
+        "--sets",
+        "1",
+        "--integrand",
+        "disk:r=0.3",
+    ]);
+    let text = String::from_utf8_lossy(&one.stdout);
+    assert!(text.contains("stderr unknown (one set"), "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]
@@ -535,5 +616,107 @@ fn numpy_outputs_load_back() {
     let row = text.lines().find(|l| l.starts_with("3,-2,")).unwrap();
     let power: f64 = row.rsplit(',').next().unwrap().parse().unwrap();
     assert_eq!(at(7 - 2, 7 + 3), power, "row ky + h, column kx + h");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn sizes_beyond_memory_are_refused_before_allocating() {
+    let run = |args: &[&str], limit: Option<&str>| {
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_varspec"));
+        cmd.args(args);
+        if let Some(l) = limit {
+            cmd.env("VARSPEC_MEMORY_MIB", l);
+        }
+        cmd.output().unwrap()
+    };
+    for (args, limit, phrase) in [
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "umj",
+                "-n",
+                "64",
+                "--integrand",
+                "defocus",
+                "--res",
+                "255",
+            ],
+            None,
+            "a non-uniform FFT on the 255^4 frequency box",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "umj",
+                "-n",
+                "64",
+                "--integrand",
+                "defocus",
+                "--res",
+                "1000000000000",
+            ],
+            None,
+            "more bytes than a 64-bit size can count",
+        ),
+        (
+            vec![
+                "optimize", "points", "-n", "256", "-d", "4", "--target", "defocus", "--res",
+                "101", "-o", "x.csv",
+            ],
+            None,
+            "lower --res (4D boxes grow as K^4)",
+        ),
+        (
+            vec![
+                "spectrum",
+                "--sampler",
+                "random",
+                "-n",
+                "64",
+                "--res",
+                "512",
+            ],
+            Some("1"),
+            "more than the 1 MiB available (VARSPEC_MEMORY_MIB overrides the limit)",
+        ),
+    ] {
+        let out = run(&args, limit);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(phrase),
+            "{args:?}: {err}"
+        );
+        assert!(
+            !err.contains("panicked") && !err.contains("memory allocation"),
+            "{err}"
+        );
+    }
+    // The 4D default box runs (it asked for 6.9 GB per allocation before).
+    let dir = temp_dir("mem4d");
+    let out_path = dir.join("o.csv");
+    let out = run(
+        &[
+            "optimize",
+            "points",
+            "-n",
+            "256",
+            "-d",
+            "4",
+            "--target",
+            "defocus",
+            "--iters",
+            "2",
+            "-o",
+            out_path.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -32,15 +32,34 @@ pub fn dims(text: &str, count: usize) -> anyhow::Result<Vec<usize>> {
 /// which sampler parameters (shared by the commands that draw sets).
 #[derive(clap::Args)]
 pub struct DrawArgs {
-    /// Realizations to draw (with a sampler).
-    #[arg(long, default_value_t = 16)]
-    pub sets: usize,
+    /// Realizations to draw (with a sampler; default 16).
+    #[arg(long = "sets")]
+    sets_given: Option<usize>,
     /// Seed: the same seed gives bit-identical realizations for any thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Sampler parameter key=value (repeatable; see `varspec sample --list`).
     #[arg(long = "param", value_parser = key_value)]
     pub params: Vec<(String, String)>,
+}
+
+impl DrawArgs {
+    /// Realizations to draw: --sets, default 16.
+    pub fn sets(&self) -> usize {
+        self.sets_given.unwrap_or(16)
+    }
+
+    /// Refuses --sets and --param where sets come from a file (they would
+    /// be silently ignored).
+    pub fn refuse_with_file(&self, file: &std::path::Path) -> anyhow::Result<()> {
+        if self.sets_given.is_some() || !self.params.is_empty() {
+            anyhow::bail!(
+                "--sets and --param apply to --sampler; {} is read whole, every set in it is used",
+                file.display()
+            );
+        }
+        Ok(())
+    }
 }
 
 /// Checks every output before any work starts (a missing folder, a folder

@@ -21,6 +21,19 @@ pub enum BenchCommand {
     Spectrum(SpectrumArgs),
     /// Variance predictors: time and error against the exact spatial form.
     Predict(PredictArgs),
+    /// Ray tracing: camera (closest-hit) and shadow (any-hit) rays per
+    /// second on a ~100k-triangle scene, CWBVH beside BVH2.
+    Render(RenderArgs),
+}
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// CSV of the table.
+    #[arg(long, default_value = "out/bench/bench-render.csv")]
+    csv: PathBuf,
+    /// Sphere tessellation of the five spheres (5: 102,400 triangles).
+    #[arg(long, default_value_t = 5)]
+    subdivisions: u32,
 }
 
 #[derive(clap::Args)]
@@ -57,12 +70,120 @@ pub fn run(c: BenchCommand) -> anyhow::Result<()> {
     let csv = match &c {
         BenchCommand::Spectrum(a) => &a.csv,
         BenchCommand::Predict(a) => &a.csv,
+        BenchCommand::Render(a) => &a.csv,
     };
     prepare(csv)?;
     match c {
         BenchCommand::Spectrum(a) => spectrum(a),
         BenchCommand::Predict(a) => predict(a),
+        BenchCommand::Render(a) => render(a),
     }
+}
+
+/// Five tessellated spheres behind one another and a floor, seen at
+/// 512 × 512: every camera ray traverses a deep tree.
+fn bench_scene(subdivisions: u32) -> String {
+    let spheres: Vec<String> = (0..5)
+        .map(|i| {
+            let x = -1.2 + 0.6 * i as f64;
+            let z = -3.0 - 0.8 * i as f64;
+            format!(
+                r#"{{"shape": "sphere", "subdivisions": {subdivisions}, "scale": [0.45, 0.45, 0.45],
+                     "translate": [{x}, 0, {z}], "material": {{"texture": "constant", "albedo": 0.5}}}}"#
+            )
+        })
+        .collect();
+    format!(
+        r#"{{"camera": {{"resolution": [512, 512], "fov_degrees": 50, "position": [0, 0.3, 0],
+              "look_at": [0, 0, -4], "focal_distance": 4, "aperture": 0}},
+            "integrand": "light", "ambient": 0.1,
+            "lights": [{{"shape": "square", "centre": [0, 3, -3], "normal": [0, -1, 0], "size": 1, "radiance": 5}}],
+            "objects": [{}, {{"shape": "box", "scale": [6, 0.05, 6], "translate": [0, -0.5, -4],
+                         "material": {{"texture": "constant", "albedo": 0.8}}}}]}}"#,
+        spheres.join(", ")
+    )
+}
+
+fn render(a: RenderArgs) -> anyhow::Result<()> {
+    use rayon::prelude::*;
+    use varspec::scene::Scene;
+    use varspec::scene::geometry::BvhKind;
+
+    let text = bench_scene(a.subdivisions);
+    let threads = rayon::current_num_threads();
+    let mut out = String::from(
+        "bvh,triangles,threads,build_seconds,camera_rays_per_second,shadow_rays_per_second,hits\n",
+    );
+    println!(
+        "{:<6} {:>10} {:>8} {:>12} {:>18} {:>18}",
+        "bvh", "triangles", "threads", "build (s)", "camera rays/s", "shadow rays/s"
+    );
+    for (label, kind) in [("cwbvh", BvhKind::Cwbvh), ("bvh2", BvhKind::Bvh2)] {
+        let start = Instant::now();
+        let scene = Scene::from_text_with(&text, "bench", kind)?;
+        let build = start.elapsed().as_secs_f64();
+        let [w, h] = scene.camera().resolution();
+        let spp = 4usize;
+        let rays = w * h * spp;
+        let camera_ray = |i: usize| {
+            let (pixel, s) = (i / spp, i % spp);
+            let jitter = [(s % 2) as f64 * 0.5 + 0.25, (s / 2) as f64 * 0.5 + 0.25];
+            scene
+                .camera()
+                .ray(pixel % w, pixel / w, [jitter[0], jitter[1], 0.5, 0.5])
+        };
+        // Camera rays: closest hit; best of 3.
+        let (camera_seconds, hits) = time(3, || {
+            (0..rays)
+                .into_par_iter()
+                .filter(|&i| {
+                    let r = camera_ray(i);
+                    scene
+                        .geometry()
+                        .closest(r.origin, r.direction, 0.0)
+                        .is_some()
+                })
+                .count()
+        });
+        // Shadow rays from the hit points to the light's centre: any hit.
+        let points: Vec<[f64; 3]> = (0..rays)
+            .into_par_iter()
+            .filter_map(|i| {
+                let r = camera_ray(i);
+                scene
+                    .geometry()
+                    .closest(r.origin, r.direction, 0.0)
+                    .map(|h| std::array::from_fn(|k| h.point[k] + 1e-4 * h.normal[k]))
+            })
+            .collect();
+        let light = [0.0, 3.0, -3.0];
+        let (shadow_seconds, _) = time(3, || {
+            points
+                .par_iter()
+                .filter(|p| {
+                    let d: [f64; 3] = std::array::from_fn(|k| light[k] - p[k]);
+                    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                    let dir = d.map(|c| c / len);
+                    scene.geometry().unoccluded(**p, dir, 1e-4, len - 1e-4)
+                })
+                .count()
+        });
+        let (camera_rate, shadow_rate) = (
+            rays as f64 / camera_seconds,
+            points.len() as f64 / shadow_seconds,
+        );
+        println!(
+            "{label:<6} {:>10} {threads:>8} {build:>12.3} {camera_rate:>18.3e} {shadow_rate:>18.3e}",
+            scene.geometry().triangle_count()
+        );
+        out += &format!(
+            "{label},{},{threads},{build},{camera_rate},{shadow_rate},{hits}\n",
+            scene.geometry().triangle_count()
+        );
+    }
+    write_atomic(&a.csv, |w| w.write_all(out.as_bytes()))?;
+    println!("wrote {}", a.csv.display());
+    Ok(())
 }
 
 struct Row {

@@ -86,7 +86,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         let (variance, stderr, truncation_bound) = match method {
             MethodArg::Spatial => {
-                let e = spatial(f.as_ref(), a.draw.sets, realization)?;
+                let e = spatial(f.as_ref(), a.draw.sets(), realization)?;
                 (e.variance, e.stderr, 0.0)
             }
             MethodArg::Fourier => {
@@ -96,7 +96,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         r.saturating_sub(1) / 2
                     }),
                     1e-10,
-                    a.draw.sets,
+                    a.draw.sets(),
                     realization,
                 )?;
                 (e.variance, e.stderr, e.truncation_bound)
@@ -179,7 +179,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let out = json!({
             "sampler": a.sampler, "integrand": f.spec(),
             "method": if method == MethodArg::Spatial { "spatial" } else { "fourier" },
-            "sets": a.draw.sets,
+            "sets": a.draw.sets(),
             "points": points.iter().map(|p| json!({"n": p.n, "requested": p.requested, "variance": p.variance, "stderr": p.stderr, "truncation_bound": p.truncation_bound})).collect::<Vec<_>>(),
             "slope": fit.slope, "slope_ci": fit.slope_ci.map(|(l, h)| vec![l, h]),
             "theory": theory, "adjusted_n": adjusted,

@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+use anyhow::bail;
+
 use super::progress;
 use super::source::SourceArgs;
 use varspec::io::write_atomic;
@@ -32,6 +34,14 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
+    if !(a.bandwidth.is_finite() && a.bandwidth >= 1e-3 && a.bandwidth <= a.range) {
+        bail!(
+            "--bandwidth {:?}: the kernel's σ, in units of the packing distance r_max, must be in \
+             [0.001, --range = {:?}] (default 0.15; below 0.001 no pair falls within a kernel width)",
+            a.bandwidth,
+            a.range
+        );
+    }
     let source = a.source.resolve(None)?;
     let bar = progress::bar(source.count() as u64, "pcf");
     let sets = (0..source.count())

@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use anyhow::anyhow;
+use anyhow::{anyhow, bail};
 use clap::ValueEnum;
 use serde_json::{Value, json};
 
@@ -67,11 +67,21 @@ fn lift(index: usize, e: anyhow::Error) -> VarianceError {
     }
 }
 
+/// A standard error over `sets` realizations: unknown (JSON null) from one.
+fn known_stderr(stderr: f64, sets: usize) -> Option<f64> {
+    (sets >= 2).then_some(stderr)
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     let Some(spec) = &a.integrand else {
         return square(&a);
     };
     let f = integrands::parse(spec)?;
+    if let Some(res) = a.res.filter(|&r| r < 3) {
+        bail!(
+            "--res {res}: the Fourier box |k| < K/2 needs K >= 3 (K = 3 is the 3^d box around DC)"
+        );
+    }
     let source = a.source.resolve(Some(f.dim()))?;
     let sets = source.count();
     let n = source.points_per_set();
@@ -102,7 +112,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "fourier".into(),
             json!({
                 "variance": e.variance, "truncation_bound": e.truncation_bound, "in_box": e.in_box,
-                "tail": e.tail, "stderr": e.stderr, "res": res, "sets": e.sets,
+                "tail": e.tail, "stderr": known_stderr(e.stderr, e.sets), "res": res, "sets": e.sets,
                 "seconds": start.elapsed().as_secs_f64(),
             }),
         );
@@ -111,7 +121,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let start = Instant::now();
         let value = match spatial(f.as_ref(), sets, lend) {
             Ok(e) => json!({
-                "variance": e.variance, "stderr": e.stderr, "rounding_bound": e.rounding_bound,
+                "variance": e.variance, "stderr": known_stderr(e.stderr, e.sets),
+                "rounding_bound": e.rounding_bound,
                 "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
             }),
             Err(e @ VarianceError::NoAutocovariance { .. }) => {
@@ -163,7 +174,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 _ if v.get("skipped").is_some() => {
                     v["skipped"].as_str().unwrap_or_default().to_string()
                 }
-                _ => format!("{extra} {:.2e}", v[extra].as_f64().unwrap_or(0.0)),
+                _ => match v[extra].as_f64() {
+                    Some(x) => format!("{extra} {x:.2e}"),
+                    None => format!("{extra} unknown (one set: give --sets 2 or more)"),
+                },
             };
             println!("  {key:<10} {variance:>14}  {note}");
         }

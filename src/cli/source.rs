@@ -71,13 +71,22 @@ impl SourceArgs {
             self.points.as_ref().or(self.points_flag.as_ref()),
             &self.sampler,
         ) {
-            (Some(path), _) => Source::File {
-                sets: read_point_sets(path)?,
-                dims: dims.clone(),
-                name: path.display().to_string(),
-            },
+            (Some(path), _) => {
+                self.draw.refuse_with_file(path)?;
+                if self.n.is_some() || self.dim.is_some() {
+                    bail!(
+                        "-n and --dim apply to --sampler; {} fixes N and d itself",
+                        path.display()
+                    );
+                }
+                Source::File {
+                    sets: read_point_sets(path)?,
+                    dims: dims.clone(),
+                    name: path.display().to_string(),
+                }
+            }
             (None, Some(name)) => {
-                if self.draw.sets == 0 {
+                if self.draw.sets() == 0 {
                     bail!("--sets must be at least 1");
                 }
                 let n = self.n.context("--sampler needs -n")?;
@@ -85,7 +94,7 @@ impl SourceArgs {
                 Source::Sampler {
                     sampler,
                     seed: self.draw.seed,
-                    sets: self.draw.sets,
+                    sets: self.draw.sets(),
                     dims: dims.clone(),
                     name: format!("{name} N={n}"),
                 }

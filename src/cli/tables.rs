@@ -60,17 +60,26 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let (sets, source) = match (&a.sampler, &a.from) {
         (Some(name), _) => {
             let n = a.n.context("--sampler needs -n")?;
-            if a.draw.sets == 0 {
+            if a.draw.sets() == 0 {
                 bail!("--sets must be at least 1");
             }
             let s = samplers::build(name, n, a.dim, &a.draw.params)?;
-            let bar = progress::bar(a.draw.sets as u64, "sampling");
+            let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =
-                samplers::generate_sets(s.as_ref(), a.draw.seed, a.draw.sets, &|| bar.inc(1))?;
+                samplers::generate_sets(s.as_ref(), a.draw.seed, a.draw.sets(), &|| bar.inc(1))?;
             bar.finish_and_clear();
             (sets, name.clone())
         }
-        (None, Some(path)) => (read_point_sets(path)?, path.display().to_string()),
+        (None, Some(path)) => {
+            a.draw.refuse_with_file(path)?;
+            if a.n.is_some() || a.dim.is_some() {
+                bail!(
+                    "-n and --dim apply to --sampler; {} fixes N and d itself",
+                    path.display()
+                );
+            }
+            (read_point_sets(path)?, path.display().to_string())
+        }
         (None, None) => bail!("give --sampler or --from"),
     };
     let optimized_for = match &a.sampler {

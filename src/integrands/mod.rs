@@ -102,6 +102,14 @@ pub enum IntegrandError {
         /// The offending part.
         part: String,
     },
+    /// A key given twice.
+    #[error("integrand spec `{spec}`: `{key}` is given twice (each parameter once)")]
+    Repeated {
+        /// The whole spec.
+        spec: String,
+        /// The repeated key.
+        key: String,
+    },
     /// A value out of its domain.
     #[error("{integrand}: {key}={value} is invalid: expected {expected}")]
     Value {

@@ -220,6 +220,12 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
                     .join(", "),
             });
         }
+        if pairs.iter().any(|(seen, _): &(String, String)| seen == k) {
+            return Err(IntegrandError::Repeated {
+                spec: spec.to_string(),
+                key: k.to_string(),
+            });
+        }
         pairs.push((k.to_string(), v.trim().to_string()));
     }
     let p = Params { info, pairs };

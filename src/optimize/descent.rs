@@ -47,11 +47,19 @@ impl DescentOptions {
     /// cannot see), K = clamp(⌈8·N^(1/d)⌉, 32, 256): measured on a
     /// half-plane at N = 1024, the cap 128 left 87% of the variance beyond
     /// the box and reached 0.30× CMJ, 256 reaches 0.21× (results/optimize-adapted).
+    /// In 3D and 4D the box holds (2K+1)^d frequencies and the transform
+    /// (4K)^d cells per thread, so K is capped at 40 and 12 (4D, K = 12:
+    /// about 0.4 GB on 2 threads; K = 32 asked for 9 GB).
     pub fn for_target(n: usize, dim: usize, target: &Target) -> Self {
         let root = (n as f64).powf(1.0 / dim as f64);
         let half = match target {
             Target::Integrand(_) => ((8.0 * root).ceil() as usize).clamp(32, 256),
             _ => ((2.5 * root).ceil() as usize).clamp(16, 400),
+        };
+        let half = match dim {
+            3 => half.min(40),
+            4 => half.min(12),
+            _ => half,
         };
         DescentOptions {
             half,
@@ -100,6 +108,7 @@ impl PointOptimizer {
             dim,
             half: options.half,
         };
+        crate::spectrum::nufft::check_nufft_memory(&freqs)?;
         let weights = target.weights(&freqs)?;
         Self::with_weights(freqs, weights, options)
     }

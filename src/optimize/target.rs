@@ -277,9 +277,16 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("w.csv");
         std::fs::write(&path, "k,weight\n1,1e308\n10,5e307\n30,0\n").unwrap();
-        assert_eq!(read_radial(&path).unwrap(), vec![(1.0, 1.0), (10.0, 0.5), (30.0, 0.0)]);
+        assert_eq!(
+            read_radial(&path).unwrap(),
+            vec![(1.0, 1.0), (10.0, 0.5), (30.0, 0.0)]
+        );
         std::fs::write(&path, "k,weight\n1,0\n2,0\n").unwrap();
-        assert!(read_radial(&path).unwrap_err().contains("no positive weight"));
+        assert!(
+            read_radial(&path)
+                .unwrap_err()
+                .contains("no positive weight")
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -12,7 +12,7 @@ pub mod render;
 
 use camera::Camera;
 use description::{IntegrandKind, LightFile, LightShape, MaterialFile, SceneError, SceneFile};
-use geometry::{Geometry, Placement, dot};
+use geometry::{BvhKind, Geometry, Placement, dot};
 
 /// The built-in scenes: name, what it shows, its JSON.
 pub const BUILTIN_SCENES: [(&str, &str, &str); 3] = [
@@ -144,11 +144,19 @@ impl Scene {
     /// # Errors
     /// [`SceneError::Syntax`] or [`SceneError::Field`].
     pub fn from_text(text: &str, name: &str) -> Result<Scene, SceneError> {
+        Scene::from_text_with(text, name, BvhKind::Bvh2)
+    }
+
+    /// As [`Self::from_text`] with a chosen BVH.
+    ///
+    /// # Errors
+    /// [`SceneError::Syntax`] or [`SceneError::Field`].
+    pub fn from_text_with(text: &str, name: &str, bvh: BvhKind) -> Result<Scene, SceneError> {
         let file = SceneFile::parse(text, name)?;
         Ok(Scene {
             name: name.into(),
             camera: Camera::new(&file.camera),
-            geometry: Geometry::build(&file.objects),
+            geometry: Geometry::build_with(&file.objects, bvh),
             placements: file.objects.iter().map(Placement::of).collect(),
             lights: file.lights.iter().map(Light::new).collect(),
             file,

@@ -12,9 +12,6 @@ use crate::points::PointSet;
 /// output bit — is independent of the thread count.
 const CHUNK: usize = 8;
 
-/// Largest working memory a spectrum may claim.
-const MEMORY_LIMIT_MIB: u64 = 8 * 1024;
-
 /// How S(k) is computed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Method {
@@ -69,16 +66,11 @@ pub fn check_memory(freqs: &FrequencyBox, method: Method, res: usize) -> Result<
             side.powi(d) * 8.0 * (threads + 1.0) + threads * 2.0 * (2.0 * side).powi(d) * 16.0
         }
     };
-    let needed_mib = (bytes / (1024.0 * 1024.0)).ceil() as u64;
-    if needed_mib > MEMORY_LIMIT_MIB {
-        return Err(SpectrumError::TooLarge {
-            what: "power spectrum",
-            res,
-            dim: freqs.dim,
-            needed_mib,
-            limit_mib: MEMORY_LIMIT_MIB,
-        });
-    }
+    crate::memory::check(
+        &format!("a power spectrum of resolution {res} in {}D", freqs.dim),
+        Some(bytes),
+        "lower --res",
+    )?;
     Ok(())
 }
 

@@ -25,8 +25,18 @@ impl FrequencyBox {
     }
 
     /// Number of frequencies, (2h+1)^d.
+    ///
+    /// # Panics
+    /// When (2h+1)^d overflows; boxes from user input pass through
+    /// [`Self::checked_len`] (and the memory check) first.
     pub fn len(&self) -> usize {
-        self.side().pow(self.dim as u32)
+        self.checked_len()
+            .expect("frequency boxes are size-checked before use")
+    }
+
+    /// (2h+1)^d, or `None` when it overflows.
+    pub fn checked_len(&self) -> Option<usize> {
+        (2usize.checked_mul(self.half)?.checked_add(1)?).checked_pow(self.dim as u32)
     }
 
     /// Never empty (h = 0 still holds k = 0).

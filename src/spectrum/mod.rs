@@ -22,22 +22,9 @@ pub enum SpectrumError {
     /// Tolerance outside what the kernel can reach.
     #[error("tolerance {0} is outside [1e-14, 0.1]")]
     Tolerance(f64),
-    /// The transform would need more memory than allowed.
-    #[error(
-        "a {what} of resolution {res} in {dim}D needs about {needed_mib} MiB, more than the {limit_mib} MiB allowed: lower --res"
-    )]
-    TooLarge {
-        /// What would be allocated.
-        what: &'static str,
-        /// Requested resolution K.
-        res: usize,
-        /// Dimension.
-        dim: usize,
-        /// Estimated need.
-        needed_mib: u64,
-        /// The limit.
-        limit_mib: u64,
-    },
+    /// The transform would need more memory than the machine gives.
+    #[error(transparent)]
+    TooLarge(#[from] crate::memory::TooMuchMemory),
     /// Transforms exist for d = 1..=4.
     #[error("spectra are computed in 1 to 4 dimensions, not {0} (project with --dims)")]
     UnsupportedDimension(usize),

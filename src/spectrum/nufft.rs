@@ -74,6 +74,7 @@ impl NufftPlan {
         if !(1e-14..=0.1).contains(&tolerance) {
             return Err(SpectrumError::Tolerance(tolerance));
         }
+        check_nufft_memory(&freqs)?;
         let width = ((1.0 / tolerance).log10().ceil() as usize + 1).clamp(2, 16);
         let beta = 2.30 * width as f64;
         let grid = fine_grid_size(2 * freqs.side()).max(2 * width);
@@ -417,6 +418,32 @@ fn kernel_transform(xi: f64, width: usize, beta: f64) -> f64 {
 }
 
 /// The smallest 2^a·3^b·5^c ≥ `min` (sizes RustFFT handles fastest).
+/// Refuses a box whose transform would not fit in memory: each thread holds
+/// two complex fine grids of at least (2(2h+1))^d cells, plus the box's
+/// coefficients.
+///
+/// # Errors
+/// [`SpectrumError::TooLarge`] with the estimate.
+pub fn check_nufft_memory(freqs: &FrequencyBox) -> Result<(), SpectrumError> {
+    let threads = rayon::current_num_threads() as f64;
+    let side = freqs.side() as f64;
+    let d = freqs.dim as i32;
+    let bytes = freqs
+        .checked_len()
+        .map(|len| threads * 2.0 * (2.0 * side).powi(d) * 16.0 + len as f64 * 24.0);
+    crate::memory::check(
+        &format!(
+            "a non-uniform FFT on the {}^{} frequency box (|k| <= {})",
+            freqs.side(),
+            freqs.dim,
+            freqs.half
+        ),
+        bytes,
+        "lower --res (4D boxes grow as K^4)",
+    )?;
+    Ok(())
+}
+
 fn fine_grid_size(min: usize) -> usize {
     (min..)
         .find(|&n| {

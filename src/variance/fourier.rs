@@ -87,6 +87,9 @@ where
     E: Send,
 {
     let freqs = FrequencyBox { dim: f.dim(), half };
+    // P_f, the expected power and the transform all live on the box: check
+    // it fits before drawing anything.
+    crate::spectrum::nufft::check_nufft_memory(&freqs)?;
     let first = realization(0)?;
     let n = first.len();
     if first.dim() != f.dim() {
