@@ -6,12 +6,13 @@
 //!    ones), the per-pixel analytic warp and the pilot choice, at 16, 64 and
 //!    256 spp: mean, median and 95th-percentile pixel variance, MSE against
 //!    a 4096-spp Sobol reference, time; variance heat maps at 64 spp.
-//! 2. Soft shadows under a square and a disk light of equal area: every 4D
-//!    sampler at 16 spp, relative RMS error per pixel against a 4096-spp
-//!    reference.
+//! 2. Soft shadows under a square and a disk light of equal area (the
+//!    square's edges along the light's (u, v) axes): 4D samplers at 16 spp,
+//!    among them jitter and uniform jitter on the light, relative RMS error
+//!    per pixel against a 4096-spp reference (the seed's table).
 //!
 //! ```sh
-//! cargo run --release --example scene_dof -- results/scene
+//! cargo run --release --example scene_dof -- results/scene [all|dof|shadows]
 //! ```
 
 use std::time::Instant;
@@ -113,7 +114,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "out/scene".into());
+    let part = std::env::args().nth(2).unwrap_or_else(|| "all".into());
     std::fs::create_dir_all(&out)?;
+    if part == "all" || part == "dof" {
+        dof(&out)?;
+    }
+    if part == "all" || part == "shadows" {
+        shadows(&out)?;
+    }
+    Ok(())
+}
+
+fn dof(out: &str) -> Result<(), Box<dyn std::error::Error>> {
     let scene = Scene::load("dof")?;
     let width = scene.camera().resolution()[0];
     let analysis = analyse(&scene);
@@ -194,7 +206,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         csv.flush()?;
     }
+    Ok(())
+}
 
+fn shadows(out: &str) -> Result<(), Box<dyn std::error::Error>> {
     let mut shadows = csv::Writer::from_path(format!("{out}/shadows.csv"))?;
     shadows.write_record([
         "light",
@@ -203,17 +218,36 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "mean_variance",
         "relative_rms_error",
     ])?;
-    for light in ["shadows-square", "shadows-disk"] {
-        let scene = Scene::load(light)?;
+    let disk = varspec::scene::BUILTIN_SCENES[2].2;
+    // The seed's setting: (u, v) uniform on the disk's bounding square, the
+    // disk an indicator in it.
+    let disk_square = disk.replace(
+        "\"radiance\": 15.0",
+        "\"radiance\": 15.0, \"sampling\": \"bounding_square\"",
+    );
+    assert_ne!(disk, disk_square, "the disk light's radiance is 15");
+    for (light, text) in [
+        ("square", varspec::scene::BUILTIN_SCENES[1].2),
+        ("disk (area)", disk),
+        ("disk (bounding square)", disk_square.as_str()),
+    ] {
+        let scene = Scene::from_text(text, light)?;
         let reference = reference_image(&scene)?;
-        for name in ["random", "jitter", "umj", "nrooks", "sobol"] {
+        for name in [
+            "random",
+            "jitter",
+            "padded:xy=jitter,uv=jitter",
+            "padded:xy=jitter,uv=uniform-jitter",
+            "umj",
+            "sobol",
+        ] {
             let sampler = samplers::build(name, 16, Some(4), &[])?;
             let none = vec![SampleShear::NONE; pixel_count(&scene)];
             let row = evaluate(&scene, sampler.as_ref(), &none, 3, RENDERS, &reference)?;
             // Relative RMS error over the lit pixels: √(mean MSE) / mean value.
             let rel = row.mse.sqrt() / mean(&reference.pixels);
             println!(
-                "{light:<15} {name:<8} 16 spp  mean var {:.3e}  relative rms {rel:.4}",
+                "{light:<24} {name:<36} 16 spp  mean var {:.3e}  relative rms {rel:.4}",
                 mean(&row.variance)
             );
             shadows.write_record([

@@ -331,3 +331,57 @@ fn optimize_commands_write_sets_and_reports() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown family"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn converge_on_a_square_family_matches_predict_and_the_jitter_rate() {
+    // Each point of the square convergence is predict --family's brute
+    // force on the same sets and members.
+    let conv = json(&[
+        "converge",
+        "--sampler",
+        "jitter",
+        "--family",
+        "halfplanes",
+        "-n",
+        "64,256,1024",
+        "--sets",
+        "8",
+        "--members",
+        "512",
+        "--seed",
+        "4",
+        "--json",
+    ]);
+    let pred = json(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "256",
+        "--family",
+        "halfplanes",
+        "--sets",
+        "8",
+        "--members",
+        "512",
+        "--seed",
+        "4",
+        "--json",
+    ]);
+    let at256 = &conv["points"][1];
+    assert_eq!(at256["n"], 256);
+    let (c, p) = (
+        at256["variance"].as_f64().unwrap(),
+        pred["brute_force"]["mse"].as_f64().unwrap(),
+    );
+    assert!((c / p - 1.0).abs() < 1e-12, "converge {c} vs predict {p}");
+    // Jitter on discontinuities: N^-1.5 (Pilleboue et al. 2015, Table 1).
+    // The fitted slope's 95% CI must hold it.
+    let ci = conv["slope_ci"].as_array().unwrap();
+    let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+    assert!(
+        lo <= -1.5 && -1.5 <= hi,
+        "slope CI [{lo}, {hi}] misses -1.5: {conv}"
+    );
+    assert!(conv["method"].as_str().unwrap().starts_with("square"));
+}

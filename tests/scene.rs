@@ -217,3 +217,46 @@ fn the_warp_that_follows_the_light_field_cuts_the_variance_of_a_defocused_edge()
         );
     }
 }
+
+#[test]
+fn a_disk_light_sampled_on_its_area_or_its_bounding_square_gives_one_image() {
+    use varspec::samplers;
+    use varspec::scene::analysis::SampleShear;
+    use varspec::scene::render::render_variance;
+    let disk = varspec::scene::BUILTIN_SCENES[2]
+        .2
+        .replace("[256, 256]", "[12, 12]");
+    let square = disk.replace(
+        "\"radiance\": 15.0",
+        "\"radiance\": 15.0, \"sampling\": \"bounding_square\"",
+    );
+    assert_ne!(disk, square);
+    let sampler = samplers::build("random", 64, Some(4), &[]).unwrap();
+    let renders = 48;
+    let maps = |text: &str| {
+        let scene = Scene::from_text(text, "disk").unwrap();
+        render_variance(
+            &scene,
+            sampler.as_ref(),
+            &vec![SampleShear::NONE; 144],
+            3,
+            renders,
+            &|| {},
+        )
+        .unwrap()
+    };
+    let (a, b) = (maps(&disk), maps(&square));
+    let mut differ = 0;
+    for i in 0..144 {
+        let se = ((a.variance.pixels[i] + b.variance.pixels[i]) / renders as f64).sqrt();
+        // 6 standard errors of the difference: < 1e-6 family-wise over 144.
+        assert!(
+            (a.mean.pixels[i] - b.mean.pixels[i]).abs() <= 6.0 * se + 1e-12,
+            "pixel {i}: area {} vs bounding square {} (se {se:.2e})",
+            a.mean.pixels[i],
+            b.mean.pixels[i]
+        );
+        differ += usize::from(a.variance.pixels[i] != b.variance.pixels[i]);
+    }
+    assert!(differ > 0, "the two samplings must be different estimators");
+}

@@ -14,6 +14,7 @@ use varspec::io::write_atomic;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
 use varspec::rng::set_rng;
 use varspec::samplers;
+use varspec::square::{Family, family_mse};
 use varspec::variance::{VarianceError, fit_slope, fourier, spatial, theoretical_rate};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -29,9 +30,17 @@ pub struct Args {
     /// Sampler name.
     #[arg(long)]
     sampler: String,
-    /// Integrand spec.
+    /// Integrand spec (the torus, shift-randomized estimator).
+    #[arg(long, required_unless_present = "family", conflicts_with = "family")]
+    integrand: Option<String>,
+    /// Instead: a family of integrands on the unit square (gaussians,
+    /// halfplanes, disks, boxes, file:PATH) and the unshifted estimator's
+    /// mean squared error over it, by brute force over the members.
     #[arg(long)]
-    integrand: String,
+    family: Option<String>,
+    /// Members of the family sample (with --family).
+    #[arg(long, default_value_t = 1024)]
+    members: usize,
     /// Comma-separated N values (constrained samplers use the nearest valid N).
     #[arg(short = 'n', long = "n", value_delimiter = ',', required = true)]
     ns: Vec<usize>,
@@ -62,16 +71,38 @@ struct Point {
     truncation_bound: f64,
 }
 
+/// What the variance is of: an integrand on the torus, or a family on the
+/// square.
+enum Subject {
+    Torus(Box<dyn integrands::Integrand>),
+    Square(Family),
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
-    let f = integrands::parse(&a.integrand)?;
+    let subject = match (&a.integrand, &a.family) {
+        (Some(spec), _) => Subject::Torus(integrands::parse(spec)?),
+        (None, Some(spec)) => {
+            if a.method.is_some() || a.res.is_some() {
+                bail!(
+                    "--method and --res apply to --integrand; --family uses the brute-force family MSE"
+                );
+            }
+            Subject::Square(Family::parse(spec)?)
+        }
+        (None, None) => bail!("give --integrand or --family"),
+    };
+    let (dim, name) = match &subject {
+        Subject::Torus(f) => (f.dim(), f.spec()),
+        Subject::Square(family) => (2, family.spec()),
+    };
     if a.ns.len() < 2 {
         bail!("--n needs at least two values to fit a slope");
     }
     if a.res.is_some_and(|r| r < 3) {
         bail!("--res must be at least 3 (the box |k| < K/2 must hold a frequency besides 0)");
     }
-    let method = a.method.unwrap_or(if f.dim() == 2 {
+    let method = a.method.unwrap_or(if dim == 2 {
         MethodArg::Spatial
     } else {
         MethodArg::Fourier
@@ -80,19 +111,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut points = Vec::new();
     for &requested in &a.ns {
         let (sampler, n) =
-            samplers::build_nearest(&a.sampler, requested, Some(f.dim()), &a.draw.params)?;
+            samplers::build_nearest(&a.sampler, requested, Some(dim), &a.draw.params)?;
         let realization = |r: usize| -> Result<_, VarianceError> {
             Ok(sampler.sample(&mut set_rng(a.draw.seed, r as u64))?)
         };
-        let (variance, stderr, truncation_bound) = match method {
-            MethodArg::Spatial => {
+        let (variance, stderr, truncation_bound) = match (&subject, method) {
+            (Subject::Square(family), _) => {
+                let sets =
+                    samplers::generate_sets(sampler.as_ref(), a.draw.seed, a.draw.sets(), &|| {})?;
+                let e = family_mse(&sets, family, a.members, a.draw.seed);
+                (e.mse, e.stderr, 0.0)
+            }
+            (Subject::Torus(f), MethodArg::Spatial) => {
                 let e = spatial(f.as_ref(), a.draw.sets(), realization)?;
                 (e.variance, e.stderr, 0.0)
             }
-            MethodArg::Fourier => {
+            (Subject::Torus(f), MethodArg::Fourier) => {
                 let e = fourier(
                     f.as_ref(),
-                    a.res.map_or(varspec::variance::fourier_half(f.dim()), |r| {
+                    a.res.map_or(varspec::variance::fourier_half(dim), |r| {
                         r.saturating_sub(1) / 2
                     }),
                     1e-10,
@@ -127,7 +164,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let ns: Vec<f64> = points.iter().map(|p| p.n as f64).collect();
     let vars: Vec<f64> = points.iter().map(|p| p.variance).collect();
     let fit = fit_slope(&ns, &vars);
-    let theory = theoretical_rate(&a.sampler, f.class(), f.dim());
+    let theory = match &subject {
+        Subject::Torus(f) => theoretical_rate(&a.sampler, f.class(), dim),
+        Subject::Square(_) => None,
+    };
     let adjusted: Vec<String> = points
         .iter()
         .filter(|p| p.n != p.requested)
@@ -167,7 +207,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             });
         }
         let plot = LinePlot {
-            title: format!("{} on {}", a.sampler, f.spec()),
+            title: format!("{} on {name}", a.sampler),
             x_label: "N".into(),
             y_label: "variance".into(),
             log_log: true,
@@ -177,8 +217,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if a.json {
         let out = json!({
-            "sampler": a.sampler, "integrand": f.spec(),
-            "method": if method == MethodArg::Spatial { "spatial" } else { "fourier" },
+            "sampler": a.sampler, "integrand": name,
+            "method": match (&subject, method) {
+                (Subject::Square(_), _) => "square: unshifted estimator's MSE over the family (brute force)",
+                (_, MethodArg::Spatial) => "spatial",
+                (_, MethodArg::Fourier) => "fourier",
+            },
             "sets": a.draw.sets(),
             "points": points.iter().map(|p| json!({"n": p.n, "requested": p.requested, "variance": p.variance, "stderr": p.stderr, "truncation_bound": p.truncation_bound})).collect::<Vec<_>>(),
             "slope": fit.slope, "slope_ci": fit.slope_ci.map(|(l, h)| vec![l, h]),

@@ -114,8 +114,105 @@ pub fn write_table(
     }
 }
 
+/// C (C23) and C++ keywords, which a table name must not become.
+const C_KEYWORDS: [&str; 92] = [
+    "alignas",
+    "alignof",
+    "and",
+    "and_eq",
+    "asm",
+    "auto",
+    "bitand",
+    "bitor",
+    "bool",
+    "break",
+    "case",
+    "catch",
+    "char",
+    "char8_t",
+    "char16_t",
+    "char32_t",
+    "class",
+    "compl",
+    "concept",
+    "const",
+    "consteval",
+    "constexpr",
+    "constinit",
+    "const_cast",
+    "continue",
+    "co_await",
+    "co_return",
+    "co_yield",
+    "decltype",
+    "default",
+    "delete",
+    "do",
+    "double",
+    "dynamic_cast",
+    "else",
+    "enum",
+    "explicit",
+    "export",
+    "extern",
+    "false",
+    "float",
+    "for",
+    "friend",
+    "goto",
+    "if",
+    "inline",
+    "int",
+    "long",
+    "mutable",
+    "namespace",
+    "new",
+    "noexcept",
+    "not",
+    "not_eq",
+    "nullptr",
+    "operator",
+    "or",
+    "or_eq",
+    "private",
+    "protected",
+    "public",
+    "register",
+    "reinterpret_cast",
+    "requires",
+    "restrict",
+    "return",
+    "short",
+    "signed",
+    "sizeof",
+    "static",
+    "static_assert",
+    "static_cast",
+    "struct",
+    "switch",
+    "template",
+    "this",
+    "thread_local",
+    "throw",
+    "true",
+    "try",
+    "typedef",
+    "typeid",
+    "typename",
+    "union",
+    "unsigned",
+    "using",
+    "virtual",
+    "void",
+    "volatile",
+    "wchar_t",
+    "while",
+    "xor",
+];
+
 /// A C identifier from `name`: letters, digits and underscores, not
-/// starting with a digit.
+/// starting with a digit, not a C or C++ keyword, not reserved (a leading
+/// underscore): `table_` is put in front where needed.
 pub fn c_identifier(name: &str) -> String {
     let mut id: String = name
         .chars()
@@ -127,7 +224,10 @@ pub fn c_identifier(name: &str) -> String {
             }
         })
         .collect();
-    if id.is_empty() || id.starts_with(|c: char| c.is_ascii_digit()) {
+    if id.is_empty()
+        || id.starts_with(|c: char| c.is_ascii_digit() || c == '_')
+        || C_KEYWORDS.contains(&id.as_str())
+    {
         id.insert_str(0, "table_");
     }
     id
@@ -231,4 +331,21 @@ pub fn read_raw(
         })
         .collect();
     Ok(values.chunks(n * dim).map(<[f64]>::to_vec).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::c_identifier;
+
+    #[test]
+    fn table_names_become_valid_non_keyword_identifiers() {
+        assert_eq!(c_identifier("int"), "table_int");
+        assert_eq!(c_identifier("Float"), "table_float");
+        assert_eq!(c_identifier("class"), "table_class");
+        assert_eq!(c_identifier("_x"), "table__x");
+        assert_eq!(c_identifier("3d"), "table_3d");
+        assert_eq!(c_identifier(""), "table_");
+        assert_eq!(c_identifier("cmj-256.h"), "cmj_256_h");
+        assert_eq!(c_identifier("integer"), "integer");
+    }
 }

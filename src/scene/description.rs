@@ -146,6 +146,24 @@ pub struct LightFile {
     pub size: f64,
     /// Emitted radiance.
     pub radiance: f64,
+    /// How (u, v) reach the light: `area` (uniform on its area; the disk by
+    /// the concentric map) or `bounding_square` (uniform on the square
+    /// around it, points off a disk contributing nothing: the disk's edge
+    /// then is a discontinuity in (u, v), as in the seed's light
+    /// experiments).
+    #[serde(default)]
+    pub sampling: LightSampling,
+}
+
+/// How a light's (u, v) map onto it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LightSampling {
+    /// Uniform on the light's area.
+    #[default]
+    Area,
+    /// Uniform on its bounding square; an indicator of the light's shape.
+    BoundingSquare,
 }
 
 /// Area-light shapes.

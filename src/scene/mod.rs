@@ -11,7 +11,9 @@ pub mod image;
 pub mod render;
 
 use camera::Camera;
-use description::{IntegrandKind, LightFile, LightShape, MaterialFile, SceneError, SceneFile};
+use description::{
+    IntegrandKind, LightFile, LightSampling, LightShape, MaterialFile, SceneError, SceneFile,
+};
 use geometry::{BvhKind, Geometry, Placement, dot};
 
 /// The built-in scenes: name, what it shows, its JSON.
@@ -53,6 +55,7 @@ struct Light {
     bitangent: [f64; 3],
     size: f64,
     radiance: f64,
+    sampling: LightSampling,
 }
 
 impl Light {
@@ -77,9 +80,11 @@ impl Light {
             bitangent,
             size: l.size,
             radiance: l.radiance,
+            sampling: l.sampling,
         }
     }
 
+    /// The light's area.
     fn area(&self) -> f64 {
         match self.shape {
             LightShape::Square => self.size * self.size,
@@ -87,13 +92,30 @@ impl Light {
         }
     }
 
-    /// The point of the light at (u, v) ∈ [0, 1)², uniform in area: the
-    /// square directly, the disk by the concentric map (Shirley & Chiu
-    /// 1997), which keeps strata compact.
-    fn point(&self, u: f64, v: f64) -> [f64; 3] {
-        let (a, b) = match self.shape {
-            LightShape::Square => (self.size * (u - 0.5), self.size * (v - 0.5)),
-            LightShape::Disk => {
+    /// The area (u, v) are spread over: the light's, or its bounding
+    /// square's.
+    fn sampled_area(&self) -> f64 {
+        match self.sampling {
+            LightSampling::Area => self.area(),
+            LightSampling::BoundingSquare => self.size * self.size,
+        }
+    }
+
+    /// The point of the light at (u, v) ∈ [0, 1)², uniform on the sampled
+    /// area: the square directly, the disk by the concentric map (Shirley &
+    /// Chiu 1997, which keeps strata compact) or through its bounding
+    /// square (`None` off the disk).
+    fn point(&self, u: f64, v: f64) -> Option<[f64; 3]> {
+        let (a, b) = match (self.shape, self.sampling) {
+            (LightShape::Square, _) => (self.size * (u - 0.5), self.size * (v - 0.5)),
+            (LightShape::Disk, LightSampling::BoundingSquare) => {
+                let (a, b) = (self.size * (u - 0.5), self.size * (v - 0.5));
+                if a * a + b * b > 0.25 * self.size * self.size {
+                    return None;
+                }
+                (a, b)
+            }
+            (LightShape::Disk, LightSampling::Area) => {
                 let (p, q) = (2.0 * u - 1.0, 2.0 * v - 1.0);
                 let (r, phi) = if p == 0.0 && q == 0.0 {
                     (0.0, 0.0)
@@ -109,7 +131,9 @@ impl Light {
                 (r * phi.cos(), r * phi.sin())
             }
         };
-        std::array::from_fn(|k| self.centre[k] + a * self.tangent[k] + b * self.bitangent[k])
+        Some(std::array::from_fn(|k| {
+            self.centre[k] + a * self.tangent[k] + b * self.bitangent[k]
+        }))
     }
 }
 
@@ -204,18 +228,21 @@ impl Scene {
         let albedo = self.albedo(hit.object, hit.point);
         let mut irradiance = self.file.ambient;
         for light in &self.lights {
-            let at = if lens {
-                light.centre
+            let (at, area) = if lens {
+                (Some(light.centre), light.area())
             } else {
-                light.point(p[2], p[3])
+                (light.point(p[2], p[3]), light.sampled_area())
             };
-            irradiance += self.direct(light, at, hit.point, hit.normal);
+            if let Some(at) = at {
+                irradiance += area * self.direct(light, at, hit.point, hit.normal);
+            }
         }
         albedo * irradiance
     }
 
-    /// One-sample direct illumination from `light` through its point `at`,
-    /// as irradiance/π times the light's area (so ambient and lights add).
+    /// Direct illumination from `light` through its point `at` per unit of
+    /// light area, L_e cosθ cosθ′ / (π r²), shadowed (times the sampled
+    /// area it is one sample of an irradiance/π, so ambient and lights add).
     fn direct(&self, light: &Light, at: [f64; 3], point: [f64; 3], normal: [f64; 3]) -> f64 {
         let to = description::sub(at, point);
         let r2 = dot(to, to);
@@ -233,7 +260,7 @@ impl Scene {
         {
             return 0.0;
         }
-        light.radiance * light.area() * cos_surface * cos_light / (std::f64::consts::PI * r2)
+        light.radiance * cos_surface * cos_light / (std::f64::consts::PI * r2)
     }
 
     /// The material's albedo at a world point of object `object`. Solid
