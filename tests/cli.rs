@@ -181,6 +181,27 @@ fn bad_requests_fail_with_a_specific_message() {
             "--bandwidth 1e-300: the kernel's σ",
         ),
         (
+            vec![
+                "optimize", "points", "-n", "64", "--target", "blue", "-o", "x.csv",
+            ],
+            "nor family:disks, power:A or radial:FILE.csv",
+        ),
+        (
+            vec![
+                "optimize",
+                "points",
+                "-n",
+                "64",
+                "--target",
+                "family:disks",
+                "--iters",
+                "0",
+                "-o",
+                "x.csv",
+            ],
+            "the number of iterations (--iters) is 0",
+        ),
+        (
             vec!["sample", "random", "-n", "4", "-o", "."],
             "it is a folder; give a file name inside it",
         ),

@@ -96,13 +96,28 @@ impl PointOptimizer {
                 "point optimization works in 1 to 4 dimensions, not {dim}"
             )));
         }
-        if options.iters == 0
-            || !(options.step > 0.0 && options.final_step > 0.0)
-            || options.half == 0
-        {
-            return Err(OptimizeError::Option(
-                "iterations, steps and the box must be positive".into(),
-            ));
+        let bad = [
+            (
+                options.iters == 0,
+                "the number of iterations (--iters) is 0",
+            ),
+            (
+                !(options.step > 0.0 && options.step.is_finite()),
+                "the initial step is not a positive number",
+            ),
+            (
+                !(options.final_step > 0.0 && options.final_step.is_finite()),
+                "the final step is not a positive number",
+            ),
+            (
+                options.half == 0,
+                "the frequency box (--res) holds only k = 0",
+            ),
+        ];
+        if let Some((_, what)) = bad.iter().find(|(is_bad, _)| *is_bad) {
+            return Err(OptimizeError::Option(format!(
+                "{what}: iterations, steps and the box must be positive"
+            )));
         }
         let freqs = FrequencyBox {
             dim,

@@ -62,8 +62,14 @@ impl Target {
                 .map(Target::Radial)
                 .map_err(fail);
         }
-        integrands::parse(spec)?;
-        Ok(Target::Integrand(spec.to_string()))
+        match integrands::parse(spec) {
+            Ok(_) => Ok(Target::Integrand(spec.to_string())),
+            Err(integrands::IntegrandError::Unknown { name, known }) => Err(fail(format!(
+                "`{name}` is neither an integrand ({known}) nor family:disks, power:A or \
+                 radial:FILE.csv"
+            ))),
+            Err(e) => Err(e.into()),
+        }
     }
 
     /// W(k) over the box (box order), W(0) = 0.
