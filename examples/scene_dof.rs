@@ -17,7 +17,6 @@
 
 use std::time::Instant;
 
-use varspec::report::plot::{HeatMap, heatmap_png};
 use varspec::samplers::{self, Sampler};
 use varspec::scene::Scene;
 use varspec::scene::analysis::SampleShear;
@@ -87,27 +86,6 @@ fn evaluate(
         mse: mean(&mse),
         seconds,
     })
-}
-
-fn heat(path: &str, title: &str, variance: &[f64], width: usize) -> Result<(), varspec::Error> {
-    let logs: Vec<f64> = variance
-        .iter()
-        .map(|&v| if v > 0.0 { v.log10() } else { f64::NAN })
-        .collect();
-    heatmap_png(
-        &HeatMap {
-            title: title.into(),
-            values: &logs,
-            width,
-            x_range: (0.0, width as f64),
-            y_range: (0.0, (variance.len() / width) as f64),
-            x_label: "pixel x".into(),
-            y_label: "pixel y (from the bottom)".into(),
-            bar_label: "log10 variance (grey: 0)".into(),
-            colour_range: (-6.0, -2.0),
-        },
-        std::path::Path::new(path),
-    )
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -196,11 +174,18 @@ fn dof(out: &str) -> Result<(), Box<dyn std::error::Error>> {
                 format!("{:.2}", row.seconds + choose),
             ])?;
             if spp == 64 && name != "best global" {
-                heat(
-                    &format!("{out}/dof-variance-{}.png", name.replace(' ', "-")),
-                    &format!("dof, umj 64 spp, {name}: per-pixel variance ({RENDERS} renders)"),
-                    &row.variance,
+                let image = GreyImage {
                     width,
+                    height: row.variance.len() / width,
+                    pixels: row.variance.clone(),
+                };
+                image.write_variance_png(
+                    &format!("dof, umj 64 spp, {name}: per-pixel variance ({RENDERS} renders)"),
+                    Some((-6.0, -2.0)),
+                    std::path::Path::new(&format!(
+                        "{out}/dof-variance-{}.png",
+                        name.replace(' ', "-")
+                    )),
                 )?;
             }
         }

@@ -45,6 +45,7 @@ pub mod samplers;
 pub mod scene;
 pub mod spectrum;
 pub mod square;
+pub mod tour;
 pub mod variance;
 
 pub use error::Error;

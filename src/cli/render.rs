@@ -186,9 +186,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             var.write_pfm(path)?;
         }
         if let Some(path) = &a.variance_png {
-            variance_png(
-                var,
+            var.write_variance_png(
                 &format!("variance over {} renders, {title}", a.renders),
+                None,
                 path,
             )?;
         }
@@ -318,34 +318,4 @@ fn summary_json(
         out["mse_against_reference"] = serde_json::json!(mean(&mse));
     }
     out
-}
-
-fn variance_png(var: &GreyImage, title: &str, path: &std::path::Path) -> anyhow::Result<()> {
-    let logs: Vec<f64> = var
-        .pixels
-        .iter()
-        .map(|&v| if v > 0.0 { v.log10() } else { f64::NAN })
-        .collect();
-    let finite: Vec<f64> = logs.iter().copied().filter(|v| v.is_finite()).collect();
-    let (lo, hi) = if finite.is_empty() {
-        (-1.0, 0.0)
-    } else {
-        let hi = quantile(&finite, 0.999);
-        (quantile(&finite, 0.01).max(hi - 6.0), hi)
-    };
-    heatmap_png(
-        &HeatMap {
-            title: title.into(),
-            values: &logs,
-            width: var.width,
-            x_range: (0.0, var.width as f64),
-            y_range: (0.0, var.height as f64),
-            x_label: "pixel x".into(),
-            y_label: "pixel y (from the bottom)".into(),
-            bar_label: "log10 variance (grey: 0)".into(),
-            colour_range: (lo, hi.max(lo + 1e-9)),
-        },
-        path,
-    )?;
-    Ok(())
 }

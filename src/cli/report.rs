@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use varspec::report::html::render_tour;
-use varspec::report::tour::{TourOptions, run_tour, write_data};
+use varspec::tour::html::render_tour;
+use varspec::tour::{TourOptions, run_tour, write_data};
 
 #[derive(clap::Args)]
 pub struct Args {

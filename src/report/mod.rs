@@ -1,7 +1,5 @@
-//! Reports: pictures and tables people look at, and the tour of the
-//! design loop as one HTML page.
+//! Pictures and plots people look at: point sets, spectra and heat maps,
+//! line plots (PNG). The tour page that assembles them is `crate::tour`.
 
-pub mod html;
 pub mod plot;
 pub mod png;
-pub mod tour;

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use crate::Error;
 use crate::io::write_atomic;
+use crate::report::plot::{HeatMap, heatmap_png};
 
 /// A grey image, rows from the top.
 #[derive(Debug, Clone, PartialEq)]
@@ -124,5 +125,51 @@ impl GreyImage {
         let img = ::image::RgbImage::from_raw(self.width as u32, self.height as u32, bytes)
             .expect("buffer matches size");
         crate::report::png::save_png(&img, path)
+    }
+}
+
+impl GreyImage {
+    /// Writes a per-pixel variance image as a log10 heat map with a colour
+    /// bar (zero variance grey). `colour_range` fixes the log10 range (to
+    /// compare maps); by default it spans the 1st to 99.9th percentile, at
+    /// most six decades.
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming `path`.
+    pub fn write_variance_png(
+        &self,
+        title: &str,
+        colour_range: Option<(f64, f64)>,
+        path: &Path,
+    ) -> Result<(), Error> {
+        let logs: Vec<f64> = self
+            .pixels
+            .iter()
+            .map(|&v| if v > 0.0 { v.log10() } else { f64::NAN })
+            .collect();
+        let (lo, hi) = colour_range.unwrap_or_else(|| {
+            let mut finite: Vec<f64> = logs.iter().copied().filter(|v| v.is_finite()).collect();
+            if finite.is_empty() {
+                return (-1.0, 0.0);
+            }
+            finite.sort_by(f64::total_cmp);
+            let at = |q: f64| finite[((q * finite.len() as f64) as usize).min(finite.len() - 1)];
+            let hi = at(0.999);
+            (at(0.01).max(hi - 6.0), hi)
+        });
+        heatmap_png(
+            &HeatMap {
+                title: title.into(),
+                values: &logs,
+                width: self.width,
+                x_range: (0.0, self.width as f64),
+                y_range: (0.0, self.height as f64),
+                x_label: "pixel x".into(),
+                y_label: "pixel y (from the bottom)".into(),
+                bar_label: "log10 variance (grey: 0)".into(),
+                colour_range: (lo, hi.max(lo + 1e-9)),
+            },
+            path,
+        )
     }
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 use base64::Engine;
 use serde_json::Value;
 
-use super::tour::{Tour, TourError};
+use super::{Tour, TourError};
 
 const TEMPLATE: &str = include_str!("templates/tour.html");
 

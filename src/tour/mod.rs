@@ -1,9 +1,11 @@
 //! The design loop end to end on built-in defaults — the project's main
 //! job: classic samplers against an optimized set with the three variance
 //! predictors side by side, spectra and radial profiles, a design for the
-//! unit square, a shear search on a defocus pixel, and the spectrum's speed
-//! against its error. [`run_tour`] computes it ([`Tour`], serializable);
-//! [`super::html::render_tour`] writes the page.
+//! unit square, a shear search on a defocus pixel, the ray-traced scene's
+//! per-pixel warp, and the spectrum's speed against its error. [`run_tour`] computes it ([`Tour`], serializable);
+//! [`html::render_tour`] writes the page.
+
+pub mod html;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -215,6 +217,42 @@ pub struct ShearSection {
     pub commands: Vec<String>,
 }
 
+/// One row of the scene section.
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneRow {
+    /// What the pixels' sets were.
+    pub method: String,
+    /// Mean over pixels of the per-pixel variance.
+    pub mean_variance: f64,
+    /// Median over pixels.
+    pub median_variance: f64,
+    /// Wall time (analysis, choice and renders).
+    pub seconds: f64,
+}
+
+/// The scene section: ray-traced pixels as 4D integrands.
+#[derive(Debug, Clone, Serialize)]
+pub struct SceneSection {
+    /// Built-in scene.
+    pub scene: String,
+    /// Samples per pixel.
+    pub spp: usize,
+    /// Independent renders behind each variance.
+    pub renders: usize,
+    /// Pixels seeing one depth, and two or more (the double wedge).
+    pub single: usize,
+    /// See `single`.
+    pub edge: usize,
+    /// Rows: unsheared and the per-pixel warp.
+    pub rows: Vec<SceneRow>,
+    /// none / warp mean variance.
+    pub reduction: f64,
+    /// The image and the variance heat maps.
+    pub pictures: Vec<Figure>,
+    /// Commands.
+    pub commands: Vec<String>,
+}
+
 /// One row of section 4.
 #[derive(Debug, Clone, Serialize)]
 pub struct SpeedRow {
@@ -254,6 +292,8 @@ pub struct Tour {
     pub square: SquareSection,
     /// Section 3.
     pub shear: ShearSection,
+    /// The scene.
+    pub scene: SceneSection,
     /// Section 4.
     pub speed: SpeedSection,
     /// Total wall time.
@@ -281,6 +321,8 @@ pub fn run_tour(options: &TourOptions, progress: &dyn Fn(&str)) -> Result<Tour, 
     let square = square_section(options)?;
     progress("shear search");
     let shear = shear_section(options)?;
+    progress("the scene");
+    let scene = scene_section(options)?;
     progress("speed against error");
     let speed = speed_section(options)?;
     Ok(Tour {
@@ -288,6 +330,7 @@ pub fn run_tour(options: &TourOptions, progress: &dyn Fn(&str)) -> Result<Tour, 
         predict,
         square,
         shear,
+        scene,
         speed,
         seconds: clock.elapsed().as_secs_f64(),
     })
@@ -579,6 +622,82 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
             "varspec optimize shear -n {n} --integrand {} --png-prefix shear --json",
             o.pixel
         )],
+    })
+}
+
+fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
+    use crate::scene::Scene;
+    use crate::scene::analysis::PixelKind;
+    use crate::scene::render::{ShearPolicy, analyse, pixel_shears, render_variance};
+    let (spp, renders) = (64, 4);
+    let scene = Scene::load("dof").map_err(at("the scene"))?;
+    let umj = samplers::build("umj", spp, Some(4), &[]).map_err(at("umj"))?;
+    let analysis = analyse(&scene);
+    let count = |k: PixelKind| analysis.iter().filter(|p| p.kind == k).count();
+    let mut rows = Vec::new();
+    let mut pictures = Vec::new();
+    for (method, file, policy) in [
+        (
+            "unsheared umj",
+            "scene-variance-none.png",
+            ShearPolicy::None,
+        ),
+        (
+            "per-pixel warp",
+            "scene-variance-warp.png",
+            ShearPolicy::Analytic,
+        ),
+    ] {
+        let start = Instant::now();
+        let shears = pixel_shears(&scene, umj.as_ref(), policy, &analysis, o.seed)
+            .map_err(at("per-pixel shears"))?;
+        let maps = render_variance(&scene, umj.as_ref(), &shears, o.seed, renders, &|| {})
+            .map_err(at("rendering"))?;
+        let seconds = start.elapsed().as_secs_f64();
+        if rows.is_empty() {
+            maps.mean
+                .write_png(1.0, &o.folder.join("scene.png"))
+                .map_err(at("writing a picture"))?;
+            pictures.push(Figure {
+                file: "scene.png".into(),
+                caption: format!("dof, mean of {renders} renders at {spp} spp"),
+            });
+        }
+        maps.variance
+            .write_variance_png(
+                &format!("{method}: per-pixel variance"),
+                Some((-6.0, -2.0)),
+                &o.folder.join(file),
+            )
+            .map_err(at("writing a picture"))?;
+        pictures.push(Figure {
+            file: file.into(),
+            caption: format!("{method}: per-pixel variance over {renders} renders"),
+        });
+        let mut sorted = maps.variance.pixels.clone();
+        sorted.sort_by(f64::total_cmp);
+        rows.push(SceneRow {
+            method: method.into(),
+            mean_variance: crate::variance::sum::sum(sorted.iter().copied()) / sorted.len() as f64,
+            median_variance: sorted[sorted.len() / 2],
+            seconds,
+        });
+    }
+    Ok(SceneSection {
+        scene: scene.name().into(),
+        spp,
+        renders,
+        single: count(PixelKind::Single),
+        edge: count(PixelKind::Edge),
+        reduction: rows[0].mean_variance / rows[1].mean_variance,
+        rows,
+        pictures,
+        commands: vec![
+            format!("varspec render dof --spp {spp} --renders {renders} --variance-png none.png"),
+            format!(
+                "varspec render dof --spp {spp} --renders {renders} --shear analytic --variance-png warp.png --shear-png slope.png"
+            ),
+        ],
     })
 }
 
