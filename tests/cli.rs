@@ -747,3 +747,23 @@ fn sizes_beyond_memory_are_refused_before_allocating() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn experiment_help_describes_the_file() {
+    let out = varspec(&["experiment", "--help"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    for field in [
+        "name ",
+        "description ",
+        "samplers ",
+        "integrands ",
+        "n ",
+        "sets ",
+        "seed ",
+    ] {
+        assert!(
+            text.contains(&format!("\n  {field}")),
+            "--help lacks `{field}`: {text}"
+        );
+    }
+}

@@ -12,6 +12,17 @@ use varspec::experiment::{Experiment, Shard, ShardFile, merge_shards, run_items,
 use varspec::io::write_atomic;
 
 #[derive(clap::Args)]
+#[command(after_help = "\
+The experiment file is one JSON object (docs/formats.md, \"Experiment file\"):
+  name         string, required: a plain file name (no / or ..); the report's
+               title and the default output folder out/experiments/<name>
+  description  string: a paragraph under the title (default \"\")
+  samplers     array of sampler names, required, non-empty
+  integrands   array of integrand specs of one dimension, required, non-empty
+  n            array of requested N, required; each sampler uses its nearest valid N
+  sets         realizations per (sampler, N), default 16
+  seed         seed of the realizations, default 0
+Unknown fields are an error. Example: experiments/rates.json")]
 pub struct Args {
     /// Experiment file (JSON; fields in docs/formats.md): name, description,
     /// samplers, integrands, n, sets, seed.
