@@ -224,3 +224,40 @@ fn poisson_disk_in_3d_reaches_its_count_at_default_radius() {
     let set = draw("poisson-disk", 2000, 3, &[], 5);
     assert_eq!(set.len(), 2000);
 }
+
+#[test]
+fn public_constructors_refuse_what_they_cannot_do() {
+    use varspec::integrands::Disk;
+    use varspec::samplers::{Halton, PoissonDisk, SamplerError};
+    assert!(matches!(
+        Halton::new(16, 33),
+        Err(SamplerError::Dimension { max: 32, .. })
+    ));
+    assert!(matches!(
+        Halton::new(0, 2),
+        Err(SamplerError::ZeroPoints { .. })
+    ));
+    assert!(Halton::new(16, 32).is_ok());
+    // r > 1/2 overlaps its own periodic images: refused, not silently wrong.
+    assert!(
+        Disk::new(0.7, [0.5, 0.5])
+            .unwrap_err()
+            .to_string()
+            .contains("(0, 0.5]")
+    );
+    assert!(Disk::new(0.3, [f64::NAN, 0.5]).is_err());
+    assert!(Disk::new(0.5, [0.5, 0.5]).is_ok());
+    // The acceleration grid's cap holds for direct construction too.
+    assert!(matches!(
+        PoissonDisk::new(1 << 30, 2, 0.5, 10),
+        Err(SamplerError::TooLarge { .. })
+    ));
+    assert!(PoissonDisk::new(100, 2, 1.5, 10).is_err());
+    assert!(PoissonDisk::new(100, 5, 0.5, 10).is_err());
+    assert!(PoissonDisk::new(100, 2, 0.5, 10).is_ok());
+    // Fewer than 2^32 coordinates, so point indices fit a u32.
+    assert!(matches!(
+        varspec::samplers::build("nrooks", 1 << 32, Some(1), &[]),
+        Err(SamplerError::TooLarge { .. })
+    ));
+}

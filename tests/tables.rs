@@ -194,3 +194,25 @@ fn f32_tables_stay_below_one() {
     assert!(values.iter().all(|v| (0.0..1.0).contains(v)));
     assert!(read_raw(&bytes[1..], TableFormat::F32, 1, 2, 2).is_err());
 }
+
+#[test]
+fn f32_tables_keep_every_point_in_its_stratum() {
+    // Jitter at m = 16 per axis (strata edges k/16 are exact in f32), and
+    // points placed a hair below each upper edge, where rounding to nearest
+    // f32 moves them onto the edge, into the next stratum.
+    let m = 16usize;
+    let below_edge: Vec<f64> = (1..=m).map(|k| k as f64 / m as f64 - 1e-12).collect();
+    let sampler = varspec::samplers::build("jitter", m * m, Some(2), &[]).unwrap();
+    let jittered = sampler.sample(&mut varspec::rng::set_rng(1, 0)).unwrap();
+    let mut checked = 0;
+    for x in below_edge.iter().chain(jittered.coords()) {
+        let v = f64::from(to_unit_f32(*x));
+        assert!(v <= *x && v < 1.0, "{x} became {v}");
+        let stratum = |t: f64| (t * m as f64).floor();
+        assert_eq!(stratum(v), stratum(*x), "{x} left its stratum as {v}");
+        checked += 1;
+    }
+    assert_eq!(checked, m + 2 * m * m);
+    // Rounding to nearest would have failed this test: the check can fail.
+    assert_eq!(f64::from((1.0f64 - 1e-12) as f32), 1.0);
+}

@@ -39,7 +39,9 @@ impl Defocus {
             DefocusShape::Box => {
                 Box::new(Rect::new(size, size, centre, 0.0).expect("an axis-aligned square fits"))
             }
-            DefocusShape::Disk => Box::new(Disk::new(0.5 * size, centre)),
+            DefocusShape::Disk => Box::new(
+                Disk::new(0.5 * size, centre).expect("a defocus size in (0, 1] gives r ≤ ½"),
+            ),
             DefocusShape::Gaussian => {
                 Box::new(Gaussian::new(0.25 * size, 0.25 * size, 0.0, centre))
             }

@@ -7,7 +7,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::{Integrand, IntegrandClass, nearest_image, sum_over_images};
+use super::{Integrand, IntegrandClass, IntegrandError, nearest_image, sum_over_images};
 use crate::spectrum::phase::exp_neg_2pi_i;
 
 /// Periodized disk indicator.
@@ -18,9 +18,30 @@ pub struct Disk {
 }
 
 impl Disk {
-    /// Radius r in (0, ½], centre c.
-    pub fn new(r: f64, centre: [f64; 2]) -> Self {
-        Disk { r, centre }
+    /// Radius r in (0, ½], centre c (finite).
+    ///
+    /// # Errors
+    /// [`IntegrandError::Value`] for a radius outside (0, ½] (a larger
+    /// disk overlaps its own periodic images and the closed forms no
+    /// longer hold) or a centre that is not finite.
+    pub fn new(r: f64, centre: [f64; 2]) -> Result<Self, IntegrandError> {
+        if !(r > 0.0 && r <= 0.5) {
+            return Err(IntegrandError::Value {
+                integrand: "disk",
+                key: "r",
+                value: r.to_string(),
+                expected: "a radius in (0, 0.5]".into(),
+            });
+        }
+        if !centre.iter().all(|c| c.is_finite()) {
+            return Err(IntegrandError::Value {
+                integrand: "disk",
+                key: "cx/cy",
+                value: format!("{centre:?}"),
+                expected: "a finite centre".into(),
+            });
+        }
+        Ok(Disk { r, centre })
     }
 
     fn area(&self) -> f64 {

@@ -235,7 +235,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
         "disk" => Box::new(Disk::new(
             p.number("r", |r| r > 0.0 && r <= 0.5, "a radius in (0, 0.5]")?,
             p.centre()?,
-        )),
+        )?),
         "box" => {
             let (w, h) = (
                 p.number("w", unit, "a side in (0, 1]")?,

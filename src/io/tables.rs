@@ -68,11 +68,19 @@ pub struct TableMetadata {
 /// The largest f32 below 1.
 pub const F32_PREV_ONE: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// x rounded to f32, kept in [0, 1).
+/// x truncated to f32: the largest f32 ≤ x, so a point never moves up
+/// across a stratum edge that f32 represents (k/m for m a power of two),
+/// and the result stays below 1 (rounding to nearest moved points of
+/// [k/m, (k+1)/m) onto (k+1)/m, and 1 − 2⁻⁵³ onto 1).
 #[inline]
 pub fn to_unit_f32(x: f64) -> f32 {
     let v = x as f32;
-    if v >= 1.0 { F32_PREV_ONE } else { v }
+    if f64::from(v) > x {
+        // v > x ≥ 0: the next f32 down is one unit less in the bits.
+        f32::from_bits(v.to_bits() - 1)
+    } else {
+        v
+    }
 }
 
 /// Writes `sets` in `format` (the sidecar, if any, is the caller's:

@@ -30,14 +30,28 @@ pub struct Halton {
 }
 
 impl Halton {
-    /// The first N points in d dimensions.
-    pub fn new(n: usize, dim: usize) -> Self {
-        Halton { n, dim }
+    /// The first N ≥ 1 points in 1 ≤ d ≤ [`MAX_DIM`] dimensions.
+    ///
+    /// # Errors
+    /// [`SamplerError::ZeroPoints`] or [`SamplerError::Dimension`].
+    pub fn new(n: usize, dim: usize) -> Result<Self, SamplerError> {
+        if n == 0 {
+            return Err(SamplerError::ZeroPoints { sampler: "halton" });
+        }
+        if !(1..=MAX_DIM).contains(&dim) {
+            return Err(SamplerError::Dimension {
+                sampler: "halton",
+                dim,
+                min: 1,
+                max: MAX_DIM,
+            });
+        }
+        Ok(Halton { n, dim })
     }
 }
 
 pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
-    Ok(Box::new(Halton::new(c.n, c.dim)))
+    Ok(Box::new(Halton::new(c.n, c.dim)?))
 }
 
 /// One dimension's scrambled radical inverse, precomputed for a set.

@@ -105,7 +105,7 @@ pub enum SamplerError {
     },
     /// N·d is too large to hold.
     #[error(
-        "{sampler}: {n} points in {dim} dimensions is more than this tool holds (at most 2^32 coordinates)"
+        "{sampler}: {n} points in {dim} dimensions is more than this tool holds (fewer than 2^32 coordinates)"
     )]
     TooLarge {
         /// Sampler name.

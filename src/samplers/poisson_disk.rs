@@ -47,14 +47,59 @@ pub struct PoissonDisk {
 }
 
 impl PoissonDisk {
-    /// N points, relative radius ρ, at most `max_trials` dart throws.
-    pub fn new(n: usize, dim: usize, rho: f64, max_trials: u64) -> Self {
-        PoissonDisk {
+    /// N ≥ 1 points in 2 ≤ d ≤ 4 dimensions, relative radius ρ in (0, 1),
+    /// at most `max_trials` ≥ 1 dart throws.
+    ///
+    /// # Errors
+    /// [`SamplerError`] for N = 0, another dimension, ρ or `max_trials`
+    /// out of range, or an acceleration grid of more than 2^28 cells.
+    pub fn new(n: usize, dim: usize, rho: f64, max_trials: u64) -> Result<Self, SamplerError> {
+        const NAME: &str = "poisson-disk";
+        if n == 0 {
+            return Err(SamplerError::ZeroPoints { sampler: NAME });
+        }
+        if !(2..=4).contains(&dim) {
+            return Err(SamplerError::Dimension {
+                sampler: NAME,
+                dim,
+                min: 2,
+                max: 4,
+            });
+        }
+        let param = |key, value: String, expected: &str| SamplerError::Param {
+            sampler: NAME,
+            key,
+            value,
+            expected: expected.into(),
+        };
+        if !(rho > 0.0 && rho < 1.0) {
+            return Err(param(
+                "radius",
+                rho.to_string(),
+                "a number in (0, 1) (relative to the densest packing)",
+            ));
+        }
+        if max_trials == 0 {
+            return Err(param(
+                "max-trials",
+                "0".into(),
+                "`auto` or a positive integer",
+            ));
+        }
+        let sampler = PoissonDisk {
             n,
             dim,
             rho,
             max_trials,
+        };
+        if pow_saturating(sampler.cells_per_axis(), dim) > MAX_CELLS {
+            return Err(SamplerError::TooLarge {
+                sampler: NAME,
+                n,
+                dim,
+            });
         }
+        Ok(sampler)
     }
 
     /// The absolute minimum distance r = ρ·r_max.
@@ -88,15 +133,7 @@ pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> 
             .filter(|&t| t >= 1)
             .ok_or_else(|| c.bad_param("max-trials", "`auto` or a positive integer"))?,
     };
-    let sampler = PoissonDisk::new(c.n, c.dim, rho, max_trials);
-    if pow_saturating(sampler.cells_per_axis(), c.dim) > MAX_CELLS {
-        return Err(SamplerError::TooLarge {
-            sampler: c.sampler,
-            n: c.n,
-            dim: c.dim,
-        });
-    }
-    Ok(Box::new(sampler))
+    Ok(Box::new(PoissonDisk::new(c.n, c.dim, rho, max_trials)?))
 }
 
 const NONE: u32 = u32::MAX;

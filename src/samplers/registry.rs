@@ -398,7 +398,9 @@ pub fn build(
     if n == 0 {
         return Err(SamplerError::ZeroPoints { sampler });
     }
-    if n.checked_mul(dim).is_none_or(|c| c > 1 << 32) {
+    // Fewer than 2^32 coordinates: point indices then fit a u32 (the
+    // permutations of N-rooks and padded pairing hold u32).
+    if n.checked_mul(dim).is_none_or(|c| c >= 1 << 32) {
         return Err(SamplerError::TooLarge { sampler, n, dim });
     }
     if let Some((key, _)) = params
