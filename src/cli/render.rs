@@ -90,6 +90,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.renders == 0 {
         bail!("--renders must be at least 1");
     }
+    if a.renders < 2 && (a.variance_png.is_some() || a.variance_pfm.is_some()) {
+        bail!("a variance needs --renders 2 or more");
+    }
     let policy = match a.shear.as_str() {
         "none" => ShearPolicy::None,
         "analytic" => ShearPolicy::Analytic,
@@ -192,8 +195,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 path,
             )?;
         }
-    } else if a.variance_png.is_some() || a.variance_pfm.is_some() {
-        bail!("a variance needs --renders 2 or more");
     }
     if let Some(path) = &a.analysis {
         write_atomic(path, |out| {
