@@ -61,6 +61,9 @@ fn output_file_matches_stdout_and_reads_back() {
     assert_eq!(std::fs::read(&path).unwrap(), stdout_run.stdout);
     let sets = varspec::io::read_point_sets(&path).unwrap();
     assert_eq!((sets.len(), sets[0].len(), sets[0].dim()), (3, 16, 2));
+    // Scientific notation names a whole count too.
+    let sci = varspec(&["sample", "random", "-n", "1e3"]);
+    assert_eq!(String::from_utf8_lossy(&sci.stdout).lines().count(), 1001);
     let utk = varspec(&["sample", "sobol", "-n", "8", "--format", "utk"]);
     let text = String::from_utf8(utk.stdout).unwrap();
     assert_eq!(text.lines().count(), 8);
@@ -200,6 +203,26 @@ fn bad_requests_fail_with_a_specific_message() {
                 "x.csv",
             ],
             "the number of iterations (--iters) is 0",
+        ),
+        (
+            vec!["sample", "random", "-n", "-1"],
+            "`-1` is negative; a count of points is a whole number >= 1",
+        ),
+        (
+            vec!["sample", "random", "-n", "2.5"],
+            "`2.5` is not a whole number of points",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "1e300",
+                "--integrand",
+                "disk",
+            ],
+            "`1e300` is more points than this tool holds",
         ),
         (
             vec!["sample", "random", "-n", "4", "-o", "."],

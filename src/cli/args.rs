@@ -72,3 +72,30 @@ pub fn check_outputs<'a>(
     }
     Ok(())
 }
+
+/// A point count N: a whole number ≥ 1, written plainly (1024) or in
+/// scientific notation when that is whole (1e6, 2.5e5); negative, fractional
+/// and huge values are refused with what was typed.
+pub fn count(text: &str) -> Result<usize, String> {
+    if let Ok(n) = text.parse::<usize>() {
+        return if n >= 1 {
+            Ok(n)
+        } else {
+            Err("a count of points must be at least 1".into())
+        };
+    }
+    match text.parse::<f64>() {
+        Ok(v) if v < 0.0 => Err(format!(
+            "`{text}` is negative; a count of points is a whole number >= 1"
+        )),
+        Ok(v) if v.fract() != 0.0 => Err(format!("`{text}` is not a whole number of points")),
+        Ok(v) if v >= 1.0 && v < 2f64.powi(52) => Ok(v as usize),
+        Ok(v) if v >= 1.0 => Err(format!(
+            "`{text}` is more points than this tool holds (fewer than 2^32 coordinates)"
+        )),
+        Ok(_) => Err("a count of points must be at least 1".into()),
+        Err(_) => Err(format!(
+            "`{text}` is not a count of points (a whole number such as 1024 or 1e6)"
+        )),
+    }
+}

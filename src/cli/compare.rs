@@ -29,7 +29,7 @@ const COMPARED: [&str; 10] = [
 #[derive(clap::Args)]
 pub struct Args {
     /// Points per set (samplers with constrained N use the nearest valid N).
-    #[arg(short = 'n', long = "n", default_value_t = 1024)]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true, default_value_t = 1024)]
     n: usize,
     /// Realizations per sampler.
     #[arg(long, default_value_t = 16)]

@@ -42,7 +42,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1024)]
     members: usize,
     /// Comma-separated N values (constrained samplers use the nearest valid N).
-    #[arg(short = 'n', long = "n", value_delimiter = ',', required = true)]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true, value_delimiter = ',', required = true)]
     ns: Vec<usize>,
     #[command(flatten)]
     draw: DrawArgs,

@@ -30,7 +30,7 @@ pub struct ShearArgs {
     #[arg(long, default_value = "umj")]
     sampler: String,
     /// Points per set.
-    #[arg(short = 'n', long = "n")]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: usize,
     /// 4D light field, e.g. defocus:shape=box,size=0.3,c=0.6 or layers:c1=0.5,c2=-0.2.
     #[arg(long)]
@@ -63,7 +63,7 @@ pub struct ShearArgs {
 #[derive(clap::Args)]
 pub struct PointsArgs {
     /// Points per set.
-    #[arg(short = 'n', long = "n")]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: usize,
     /// Dimension (1 to 4).
     #[arg(short = 'd', long = "dim", default_value_t = 2)]

@@ -12,7 +12,7 @@ pub struct Args {
     #[arg(short = 'o', long = "output", default_value = "out/report")]
     output: PathBuf,
     /// Points per set of the sampler comparison.
-    #[arg(short = 'n', long = "n", default_value_t = 256)]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true, default_value_t = 256)]
     n: usize,
     /// Sets per sampler.
     #[arg(long, default_value_t = 16)]

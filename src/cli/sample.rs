@@ -51,7 +51,7 @@ pub struct Args {
     #[arg(long = "sampler", value_name = "SAMPLER")]
     sampler_flag: Option<String>,
     /// Points per set.
-    #[arg(short = 'n', long = "n", required_unless_present = "list")]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true, required_unless_present = "list")]
     n: Option<usize>,
     /// Dimension (default: the sampler's own, 2 for most, 4 for umj).
     #[arg(short = 'd', long = "dim")]

@@ -23,7 +23,7 @@ pub struct SourceArgs {
     #[arg(long, requires = "n")]
     sampler: Option<String>,
     /// Points per realization (with --sampler).
-    #[arg(short = 'n', long = "n")]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: Option<usize>,
     /// Sampler dimension (with --sampler; default: the sampler's own).
     #[arg(short = 'd', long = "dim")]

@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long)]
     from: Option<PathBuf>,
     /// Points per set (with --sampler).
-    #[arg(short = 'n', long = "n")]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: Option<usize>,
     /// Dimension (with --sampler).
     #[arg(short = 'd', long = "dim")]
