@@ -10,13 +10,16 @@ use serde_json::{Value, json};
 use super::source::SourceArgs;
 use varspec::PointSet;
 use varspec::integrands;
-use varspec::variance::{VarianceError, empirical, fourier, spatial};
+use varspec::variance::{VarianceError, empirical, fourier_parts, radial_from, spatial};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum MethodArg {
     Fourier,
     Spatial,
     Empirical,
+    /// The radial (isotropic) form from radially averaged spectra, with its
+    /// anisotropy bound.
+    Radial,
     All,
 }
 
@@ -88,11 +91,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let wants = |m: MethodArg| a.method == m || a.method == MethodArg::All;
     // The Fourier and spatial forms pass over the same realizations: draw
     // them once (a sampler's draw can be costly, e.g. an optimized set).
-    let drawn = if wants(MethodArg::Fourier) || wants(MethodArg::Spatial) {
-        source.realizations()?
-    } else {
-        Vec::new()
-    };
+    let drawn =
+        if wants(MethodArg::Fourier) || wants(MethodArg::Spatial) || wants(MethodArg::Radial) {
+            source.realizations()?
+        } else {
+            Vec::new()
+        };
     let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(drawn[r].clone()) };
     let mut out = serde_json::Map::new();
     out.insert("integrand".into(), json!(f.spec()));
@@ -103,19 +107,34 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "estimator".into(),
         json!("shift-randomized: uniform toroidal shift of every dimension"),
     );
-    if wants(MethodArg::Fourier) {
+    if wants(MethodArg::Fourier) || wants(MethodArg::Radial) {
         let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
         let half = res.saturating_sub(1) / 2;
         let start = Instant::now();
-        let e = fourier(f.as_ref(), half, a.tol, sets, lend)?;
-        out.insert(
-            "fourier".into(),
-            json!({
-                "variance": e.variance, "truncation_bound": e.truncation_bound, "in_box": e.in_box,
-                "tail": e.tail, "stderr": known_stderr(e.stderr, e.sets), "res": res, "sets": e.sets,
-                "seconds": start.elapsed().as_secs_f64(),
-            }),
-        );
+        let parts = fourier_parts(f.as_ref(), half, a.tol, sets, lend)?;
+        let seconds = start.elapsed().as_secs_f64();
+        if wants(MethodArg::Radial) {
+            let r = radial_from(&parts);
+            out.insert(
+                "radial".into(),
+                json!({
+                    "variance": r.variance, "anisotropy_bound": r.anisotropy_bound,
+                    "truncation_bound": r.truncation_bound, "rings": r.rings, "res": res,
+                    "seconds": seconds,
+                }),
+            );
+        }
+        let e = parts.estimate;
+        if wants(MethodArg::Fourier) {
+            out.insert(
+                "fourier".into(),
+                json!({
+                    "variance": e.variance, "truncation_bound": e.truncation_bound, "in_box": e.in_box,
+                    "tail": e.tail, "stderr": known_stderr(e.stderr, e.sets), "res": res, "sets": e.sets,
+                    "seconds": seconds,
+                }),
+            );
+        }
     }
     if wants(MethodArg::Spatial) {
         let start = Instant::now();
@@ -160,6 +179,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ("fourier", "truncation_bound"),
         ("spatial", "stderr"),
         ("empirical", "ci_low"),
+        ("radial", "anisotropy_bound"),
     ] {
         if let Some(v) = out.get(key) {
             let variance = v["variance"]

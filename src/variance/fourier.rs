@@ -30,7 +30,7 @@ use super::VarianceError;
 use super::sum::NeumaierSum;
 use crate::integrands::Integrand;
 use crate::points::PointSet;
-use crate::spectrum::{FrequencyBox, Method, expected_power_with};
+use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power_with};
 
 /// Shell deviation |N·P_S − 1| above which the spectrum is treated as a
 /// lattice's (see the module doc).
@@ -82,6 +82,38 @@ pub fn fourier<E>(
     sets: usize,
     realization: impl Fn(usize) -> Result<PointSet, E> + Sync,
 ) -> Result<FourierEstimate, VarianceError>
+where
+    VarianceError: From<E>,
+    E: Send,
+{
+    fourier_parts(f, half, tolerance, sets, realization).map(|p| p.estimate)
+}
+
+/// The Fourier prediction with what it was computed from: the expected
+/// power E[N·P_S] and P_f on the box (the radial form reuses them).
+#[derive(Debug, Clone)]
+pub struct FourierParts {
+    /// The prediction.
+    pub estimate: FourierEstimate,
+    /// E[N·P_S(k)] on the box.
+    pub spectrum: Spectrum,
+    /// P_f(k) on the box, in box order.
+    pub integrand_power: Vec<f64>,
+    /// N.
+    pub n: usize,
+}
+
+/// As [`fourier`], keeping the spectra.
+///
+/// # Errors
+/// As [`fourier`].
+pub fn fourier_parts<E>(
+    f: &dyn Integrand,
+    half: usize,
+    tolerance: f64,
+    sets: usize,
+    realization: impl Fn(usize) -> Result<PointSet, E> + Sync,
+) -> Result<FourierParts, VarianceError>
 where
     VarianceError: From<E>,
     E: Send,
@@ -186,13 +218,18 @@ where
     let in_box = in_box.value() / nf;
     let tail = tail_mass / nf;
     let (_, stderr) = super::spatial::mean_and_stderr(&per_set);
-    Ok(FourierEstimate {
-        variance: in_box + tail,
-        stderr: stderr / nf,
-        truncation_bound,
-        in_box,
-        tail,
-        half,
-        sets,
+    Ok(FourierParts {
+        estimate: FourierEstimate {
+            variance: in_box + tail,
+            stderr: stderr / nf,
+            truncation_bound,
+            in_box,
+            tail,
+            half,
+            sets,
+        },
+        spectrum,
+        integrand_power: pf,
+        n,
     })
 }

@@ -12,13 +12,15 @@ pub mod convergence;
 pub mod empirical;
 pub mod fourier;
 pub mod measure;
+pub mod radial;
 pub mod spatial;
 pub mod sum;
 
 pub use convergence::{SlopeFit, fit_slope, theoretical_rate};
 pub use empirical::{EmpiricalEstimate, empirical, empirical_shifting};
-pub use fourier::{FourierEstimate, fourier};
+pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_parts};
 pub use measure::{SamplerVariance, fourier_half, sampler_variance};
+pub use radial::{RadialEstimate, radial_from};
 pub use spatial::{SpatialEstimate, spatial, spatial_variance};
 
 use crate::samplers::SamplerError;
