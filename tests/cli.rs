@@ -205,6 +205,18 @@ fn bad_requests_fail_with_a_specific_message() {
             "the number of iterations (--iters) is 0",
         ),
         (
+            vec![
+                "predict",
+                "--sampler",
+                "cmj",
+                "-n",
+                "64",
+                "--integrand",
+                "defocus",
+            ],
+            "draw them in 4D with -d 4",
+        ),
+        (
             vec!["sample", "random", "-n", "-1"],
             "`-1` is negative; a count of points is a whole number >= 1",
         ),

@@ -115,6 +115,14 @@ impl SourceArgs {
             None => own,
         };
         if let Some(dim) = dim.filter(|&d| d != found) {
+            if matches!(source, Source::Sampler { .. }) && dims.is_none() && found < dim {
+                bail!(
+                    "{}: points are {found}-dimensional where {dim} dimensions are needed; \
+                     draw them in {dim}D with -d {dim} (a sampler that has it, e.g. jitter, \
+                     random, sobol) or use a 4D sampler (umj, padded:xy=...,uv=...)",
+                    source.name()
+                );
+            }
             bail!(
                 "{}: points are {found}-dimensional where {dim} dimensions are needed; choose a projection with --dims \
                  (0,2 is XU, 1,3 is YV)",
