@@ -21,19 +21,11 @@ use varspec::samplers::{self, Sampler};
 use varspec::scene::Scene;
 use varspec::scene::analysis::SampleShear;
 use varspec::scene::image::GreyImage;
-use varspec::scene::render::{ShearPolicy, analyse, pixel_shears, render, render_variance};
+use varspec::scene::render::{
+    PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, render, render_variance,
+};
 
 const RENDERS: usize = 16;
-
-fn mean(v: &[f64]) -> f64 {
-    varspec::variance::sum::sum(v.iter().copied()) / v.len() as f64
-}
-
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1]
-}
 
 /// A reference image: the mean of 2 renders of Sobol at 4096 spp.
 fn reference_image(scene: &Scene) -> Result<GreyImage, Box<dyn std::error::Error>> {
@@ -74,16 +66,14 @@ fn evaluate(
     let start = Instant::now();
     let maps = render_variance(scene, sampler, shears, seed, renders, &|| {})?;
     let seconds = start.elapsed().as_secs_f64();
-    let r = renders as f64;
-    let mse: Vec<f64> = (0..maps.mean.pixels.len())
-        .map(|i| {
-            let d = maps.mean.pixels[i] - reference.pixels[i];
-            (r - 1.0) / r * maps.variance.pixels[i] + d * d
-        })
-        .collect();
     Ok(Row {
+        mse: mse_against(
+            &maps.mean.pixels,
+            Some(&maps.variance.pixels),
+            renders,
+            &reference.pixels,
+        ),
         variance: maps.variance.pixels,
-        mse: mean(&mse),
         seconds,
     })
 }
@@ -135,7 +125,7 @@ fn dof(out: &str) -> Result<(), Box<dyn std::error::Error>> {
         for &c in &candidates {
             let shears = vec![c; analysis.len()];
             let maps = render_variance(&scene, sampler.as_ref(), &shears, 7, 2, &|| {})?;
-            let v = mean(&maps.variance.pixels);
+            let v = PixelStatistics::of(&maps.variance.pixels).mean;
             if v < best.1 {
                 best = (c, v);
             }
@@ -156,9 +146,10 @@ fn dof(out: &str) -> Result<(), Box<dyn std::error::Error>> {
                 ShearPolicy::None => "none".into(),
                 _ => "per pixel".into(),
             };
+            let stats = PixelStatistics::of(&row.variance);
             println!(
                 "dof umj {spp:>3} spp  {name:<20} {label:<16} mean var {:.3e}  mse {:.3e}  {:.1} s",
-                mean(&row.variance),
+                stats.mean,
                 row.mse,
                 row.seconds + choose
             );
@@ -167,9 +158,9 @@ fn dof(out: &str) -> Result<(), Box<dyn std::error::Error>> {
                 name.into(),
                 label,
                 RENDERS.to_string(),
-                format!("{:e}", mean(&row.variance)),
-                format!("{:e}", quantile(&row.variance, 0.5)),
-                format!("{:e}", quantile(&row.variance, 0.95)),
+                format!("{:e}", stats.mean),
+                format!("{:e}", stats.median),
+                format!("{:e}", stats.p95),
                 format!("{:e}", row.mse),
                 format!("{:.2}", row.seconds + choose),
             ])?;
@@ -230,16 +221,16 @@ fn shadows(out: &str) -> Result<(), Box<dyn std::error::Error>> {
             let none = vec![SampleShear::NONE; pixel_count(&scene)];
             let row = evaluate(&scene, sampler.as_ref(), &none, 3, RENDERS, &reference)?;
             // Relative RMS error over the lit pixels: √(mean MSE) / mean value.
-            let rel = row.mse.sqrt() / mean(&reference.pixels);
+            let rel = row.mse.sqrt() / PixelStatistics::of(&reference.pixels).mean;
             println!(
                 "{light:<24} {name:<36} 16 spp  mean var {:.3e}  relative rms {rel:.4}",
-                mean(&row.variance)
+                PixelStatistics::of(&row.variance).mean
             );
             shadows.write_record([
                 light.to_string(),
                 name.into(),
                 "16".into(),
-                format!("{:e}", mean(&row.variance)),
+                format!("{:e}", PixelStatistics::of(&row.variance).mean),
                 format!("{rel:.5}"),
             ])?;
         }

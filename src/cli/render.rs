@@ -12,7 +12,9 @@ use varspec::report::plot::{HeatMap, heatmap_png};
 use varspec::samplers;
 use varspec::scene::analysis::{PixelKind, SampleShear};
 use varspec::scene::image::GreyImage;
-use varspec::scene::render::{ShearPolicy, analyse, pixel_shears, render, render_variance};
+use varspec::scene::render::{
+    PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, render, render_variance,
+};
 use varspec::scene::{BUILTIN_SCENES, Scene};
 
 #[derive(clap::Args)]
@@ -250,23 +252,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.renders,
         (w * h * a.spp * a.renders) as f64 / seconds / 1e6,
         match &variance {
-            Some(v) => format!(", mean pixel variance {:.4e}", mean(&v.pixels)),
+            Some(v) => format!(
+                ", mean pixel variance {:.4e}",
+                PixelStatistics::of(&v.pixels).mean
+            ),
             None => String::new(),
         }
     );
     eprintln!("wrote {}", output.display());
     Ok(())
-}
-
-fn mean(v: &[f64]) -> f64 {
-    varspec::variance::sum::sum(v.iter().copied()) / v.len() as f64
-}
-
-/// The `q` quantile (nearest rank) of `v`.
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    s[((q * s.len() as f64).ceil() as usize).clamp(1, s.len()) - 1]
 }
 
 fn summary_json(
@@ -296,27 +290,21 @@ fn summary_json(
         "seconds": seconds,
     });
     if let Some(v) = variance {
+        let stats = PixelStatistics::of(&v.pixels);
         out["variance"] = serde_json::json!({
-            "mean": mean(&v.pixels),
-            "median": quantile(&v.pixels, 0.5),
-            "p95": quantile(&v.pixels, 0.95),
+            "mean": stats.mean,
+            "median": stats.median,
+            "p95": stats.p95,
         });
     }
     if let Some(r) = reference {
-        // Mean over renders of (estimate − reference)²: the variance term
-        // (R − 1)/R · s² plus the squared error of the mean, per pixel.
-        let renders = a.renders as f64;
-        let mse: Vec<f64> = image
-            .pixels
-            .iter()
-            .zip(&r.pixels)
-            .enumerate()
-            .map(|(i, (m, r))| {
-                let s2 = variance.map_or(0.0, |v| v.pixels[i]);
-                (renders - 1.0) / renders * s2 + (m - r) * (m - r)
-            })
-            .collect();
-        out["mse_against_reference"] = serde_json::json!(mean(&mse));
+        let mse = mse_against(
+            &image.pixels,
+            variance.map(|v| v.pixels.as_slice()),
+            a.renders,
+            &r.pixels,
+        );
+        out["mse_against_reference"] = serde_json::json!(mse);
     }
     out
 }

@@ -10,7 +10,8 @@
 
 use super::Scene;
 use super::description::IntegrandKind;
-use crate::points::{PointSet, wrap01};
+use crate::optimize::shear::shear_set;
+use crate::points::PointSet;
 use crate::rng::PREV_ONE;
 
 /// What the probes of one pixel found.
@@ -131,10 +132,9 @@ impl SampleShear {
     pub fn apply(&self, set: PointSet) -> PointSet {
         let coords = match *self {
             SampleShear::Position([a, b]) if a == 0.0 && b == 0.0 => return set,
-            SampleShear::Position([a, b]) => set
-                .points()
-                .flat_map(|p| [wrap01(p[0] + a * p[2]), wrap01(p[1] + b * p[3]), p[2], p[3]])
-                .collect(),
+            SampleShear::Position(s) => {
+                return shear_set(&set, s).expect("callers check the sampler is 4D");
+            }
             SampleShear::Warp(kappa) => set
                 .points()
                 .flat_map(|p| {

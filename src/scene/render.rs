@@ -271,6 +271,51 @@ pub fn render_variance(
     })
 }
 
+/// The mean over pixels of the per-render squared error against
+/// `reference`: per pixel (R − 1)/R · s² + (mean − reference)², the mean
+/// over R renders of (estimate − reference)² rewritten with their mean and
+/// sample variance (no variance: one render, R = 1).
+pub fn mse_against(
+    mean: &[f64],
+    variance: Option<&[f64]>,
+    renders: usize,
+    reference: &[f64],
+) -> f64 {
+    let r = renders as f64;
+    let per_pixel = mean.iter().zip(reference).enumerate().map(|(i, (m, x))| {
+        let s2 = variance.map_or(0.0, |v| v[i]);
+        (r - 1.0) / r * s2 + (m - x) * (m - x)
+    });
+    crate::variance::sum::sum(per_pixel) / mean.len() as f64
+}
+
+/// Mean (compensated), median and 95th percentile (nearest rank) of
+/// per-pixel values, e.g. a variance map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelStatistics {
+    /// Mean.
+    pub mean: f64,
+    /// Median.
+    pub median: f64,
+    /// 95th percentile.
+    pub p95: f64,
+}
+
+impl PixelStatistics {
+    /// The statistics of `values` (non-empty).
+    pub fn of(values: &[f64]) -> PixelStatistics {
+        let mut sorted = values.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let rank =
+            |q: f64| sorted[((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1];
+        PixelStatistics {
+            mean: crate::variance::sum::sum(values.iter().copied()) / values.len() as f64,
+            median: rank(0.5),
+            p95: rank(0.95),
+        }
+    }
+}
+
 fn sample_variance(values: &[f64]) -> f64 {
     let n = values.len() as f64;
     let mean = values.iter().sum::<f64>() / n;
