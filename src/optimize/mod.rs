@@ -3,7 +3,9 @@
 //! [`target`]), and the shear search for structured 4D sets ([`shear`]).
 
 pub mod adam;
+pub mod adapted;
 pub mod descent;
+pub mod lattice;
 pub mod projections;
 pub mod repulsion;
 pub mod shear;

@@ -1,0 +1,179 @@
+//! Designs adapted to one integrand (torus, shift-randomized estimator):
+//! the integration-lattice search against the generic O(N²) spatial form,
+//! the choice between a descent and its start, and the goal of issue 8 §2
+//! on half-planes no default was tuned on.
+
+mod common;
+
+use varspec::integrands;
+use varspec::optimize::adapted::{design_sets, keep_lower_variance, lattice_start};
+use varspec::optimize::lattice::{best_lattice, lattices};
+use varspec::optimize::{DescentOptions, DescentResult, PointOptimizer, Target};
+use varspec::rng::set_rng;
+use varspec::samplers::{self, Sampler};
+use varspec::variance::{VarianceError, spatial, spatial_variance};
+
+/// The lattice rule's N-term form equals the generic all-pairs spatial
+/// form evaluated on a shifted copy of its points, and every lattice of N
+/// points is listed once (σ(N) of them).
+#[test]
+fn lattice_variance_is_the_spatial_form_of_its_points() {
+    assert_eq!(lattices(48).len(), 124, "σ(48) = 124");
+    assert_eq!(lattices(97).len(), 98, "σ(97) = 98 for a prime");
+    for spec in [
+        "halfplane:angle=61,offset=-0.17",
+        "box:w=0.3,h=0.45,angle=12,cx=0.4",
+        "disk:r=0.27,cx=0.6",
+        "gaussian:sx=0.2,sy=0.1,angle=30",
+    ] {
+        let f = integrands::parse(spec).unwrap();
+        let found = best_lattice(48, f.as_ref()).unwrap();
+        let points = found.lattice.sample(&mut set_rng(5, 0)).unwrap();
+        let (all_pairs, rounding) = spatial_variance(&points, f.as_ref()).unwrap();
+        assert!(
+            (all_pairs - found.variance).abs()
+                <= 1e-9 * all_pairs + rounding + found.rounding_bound,
+            "{spec}: lattice form {:e}, all-pairs form {all_pairs:e}",
+            found.variance
+        );
+        // No lattice of 48 points does better (the search is exhaustive).
+        for l in lattices(48) {
+            let p = l.sample(&mut set_rng(5, 1)).unwrap();
+            let (v, r) = spatial_variance(&p, f.as_ref()).unwrap();
+            assert!(
+                v >= found.variance - r - found.rounding_bound - 1e-12 * v,
+                "{spec}: {l:?} has {v:e} below the best {:e} ({:?})",
+                found.variance,
+                found.lattice
+            );
+        }
+    }
+}
+
+/// A descent that raises the exact variance returns its start, and says
+/// so; one that lowers it returns its own set.
+#[test]
+fn the_lower_exact_variance_is_kept() {
+    let f = integrands::parse("halfplane:angle=33,offset=0.1").unwrap();
+    let lattice = best_lattice(64, f.as_ref()).unwrap().lattice;
+    let good = lattice.sample(&mut set_rng(1, 0)).unwrap();
+    let bad = samplers::build("random", 64, Some(2), &[])
+        .unwrap()
+        .sample(&mut set_rng(1, 0))
+        .unwrap();
+    let result = |points: &varspec::PointSet| DescentResult {
+        points: points.clone(),
+        losses: vec![1.0, 0.5],
+        seconds: vec![0.0, 0.1],
+        best_score: 0.5,
+        start_score: 1.0,
+    };
+    let kept = keep_lower_variance(good.clone(), result(&bad), f.as_ref()).unwrap();
+    let e = kept.exact.unwrap();
+    assert!(e.kept_start && kept.points == good, "{e:?}");
+    assert!(e.start < e.descended);
+    let kept = keep_lower_variance(bad.clone(), result(&good), f.as_ref()).unwrap();
+    let e = kept.exact.unwrap();
+    assert!(!e.kept_start && kept.points == good, "{e:?}");
+}
+
+/// Issue 8 §2 on half-planes drawn for this test (no default was chosen on
+/// them). Ratios are to CMJ's mean minus three standard errors over 64
+/// realizations, so each is an upper bound at ~99.9% confidence. N = 1024:
+/// the goal, ≤ 0.15×. N = 256: the goal is ≤ 0.20×; the lattice design's
+/// point estimates are 0.14–0.20 over twelve random half-planes
+/// (results/optimize-adapted), so the bound asserted is 0.22, a regression
+/// guard rather than the goal.
+#[test]
+fn adapted_design_beats_cmj_on_unseen_halfplanes() {
+    for (n, bound) in [(256, 0.22), (1024, 0.15)] {
+        for spec in [
+            "halfplane:angle=139.7,offset=-0.23",
+            "halfplane:angle=33.3,offset=0.19",
+        ] {
+            let f = integrands::parse(spec).unwrap();
+            let target = Target::parse(spec).unwrap();
+            let optimizer =
+                PointOptimizer::new(2, &target, DescentOptions::for_target(n, 2, &target)).unwrap();
+            let start = lattice_start(n, f.as_ref()).unwrap();
+            let kept = design_sets(
+                &optimizer,
+                &start.lattice,
+                Some(f.as_ref()),
+                9,
+                1,
+                &|_, _| {},
+            )
+            .unwrap();
+            let ours = kept[0].variance().unwrap();
+            let cmj = samplers::build("cmj", n, Some(2), &[]).unwrap();
+            let c = spatial(f.as_ref(), 64, |r| -> Result<_, VarianceError> {
+                Ok(cmj.sample(&mut set_rng(17, r as u64))?)
+            })
+            .unwrap();
+            let ratio = ours / (c.variance - 3.0 * c.stderr);
+            assert!(
+                ratio <= bound,
+                "{spec}, N = {n}: variance {ours:e} is {ratio:.3} of CMJ's {:e} ± {:e} \
+                 (mean − 3 s.e.); bound {bound}",
+                c.variance,
+                c.stderr
+            );
+            eprintln!(
+                "{spec}, N = {n}: {:.3} of CMJ (bound {ratio:.3})",
+                ours / c.variance
+            );
+        }
+    }
+}
+
+/// The command line starts 2D integrand targets from the lattice, reports
+/// it, and refuses a lattice start where there is no exact form.
+#[test]
+fn optimize_points_reports_the_lattice_start() {
+    let dir = common::temp_dir("optimize-lattice");
+    let out = dir.join("hp.csv");
+    let report = dir.join("hp.json");
+    let run = common::varspec(&[
+        "optimize",
+        "points",
+        "-n",
+        "64",
+        "--target",
+        "halfplane:angle=33,offset=0.1",
+        "--sets",
+        "2",
+        "--iters",
+        "40",
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{run:?}");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        stdout.contains("the best of 127 integration lattices"),
+        "{stdout}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["init"], "lattice");
+    assert_eq!(json["exact"].as_array().unwrap().len(), 2);
+    assert!(json["lattice"]["variance"].as_f64().unwrap() > 0.0);
+    common::assert_fails(
+        &[
+            "optimize",
+            "points",
+            "-n",
+            "64",
+            "--target",
+            "family:disks",
+            "--init",
+            "lattice",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        "--init lattice needs a 2D integrand target",
+    );
+}
