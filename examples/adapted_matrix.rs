@@ -1,8 +1,8 @@
 //! Designs adapted to one integrand, on integrands drawn at random (torus,
 //! shift-randomized estimator): the default design (best integration
 //! lattice, then the spectral descent, kept by the exact form) and the
-//! previous default (descent from CMJ) against CMJ, Owen-scrambled Sobol'
-//! and jitter, all scored by the exact spatial form (no frequency box).
+//! previous default (descent from CMJ) against CMJ, Owen-scrambled Sobol',
+//! jitter and Poisson disk, all scored by the exact spatial form (no frequency box).
 //! Classic samplers: mean over 64 realizations with its standard error.
 //!
 //! ```sh
@@ -93,7 +93,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for spec in targets() {
             let f = integrands::parse(&spec)?;
             let mut classic = Vec::new();
-            for name in ["cmj", "sobol", "jitter"] {
+            for name in ["cmj", "sobol", "jitter", "poisson-disk"] {
                 let s = samplers::build(name, n, Some(2), &[])?;
                 let e = spatial(f.as_ref(), 64, |r| -> Result<_, VarianceError> {
                     Ok(s.sample(&mut set_rng(0x5c0e, r as u64))?)
@@ -137,11 +137,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 row(name, *v, *se, 0.0)?;
             }
             println!(
-                "| {n} | `{spec}` | **{:.3}** | {:.3} | {:.3} | {:.3} | {:.3e} ± {:.0}% | {seconds:.2} |",
+                "| {n} | `{spec}` | **{:.3}** | {:.3} | {:.3} | {:.3} | {:.3} | {:.3e} ± {:.0}% | {seconds:.2} |",
                 ours / cmj,
                 old / cmj,
                 classic[1].1 / cmj,
                 classic[2].1 / cmj,
+                classic[3].1 / cmj,
                 cmj,
                 100.0 * classic[0].2 / cmj
             );

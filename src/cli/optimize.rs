@@ -75,7 +75,7 @@ pub struct PointsArgs {
     domain: DomainArg,
     /// Target. Torus: an integrand spec (W = P_f), family:disks, power:A or
     /// radial:FILE.csv. Square: family MSEs and repulsion, e.g.
-    /// halfplanes+gaussians+16*blue (families: halfplanes, gaussians[:vmin=,vmax=]).
+    /// halfplanes+gaussians+16*blue (families: halfplanes, gaussians[:vmin=,vmax=], disks[:rmin=,rmax=], boxes[:smin=,smax=]).
     #[arg(long)]
     target: String,
     /// Independent realizations, optimized in parallel.

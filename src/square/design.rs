@@ -7,8 +7,9 @@
 //! points instead). A `halfplanes` term is the Cramér–von Mises form of
 //! [`super::halfplanes`] over q directions with a random offset per
 //! iteration (an unbiased estimate of the θ average: the set cannot fit a
-//! fixed set of directions); a smooth family's term is the sample form of
-//! [`super::sampled`] on fresh members each iteration (a stochastic
+//! fixed set of directions); another family's term is the sample form of
+//! [`super::sampled`] on fresh members each iteration (disks and boxes
+//! through their edge gradients smoothed over half a spacing; a stochastic
 //! gradient on the family MSE itself). The best set is kept by a
 //! deterministic score: 512 directions for half-planes, a fixed validation
 //! sample for smooth families, both drawn apart from the members the final
@@ -18,7 +19,7 @@ use rayon::prelude::*;
 
 use super::family::{Family, FamilyError};
 use super::halfplanes::{Projection, directional_loss, directions, halfplane_mse};
-use super::sampled::sampled_loss;
+use super::sampled::{Members, sampled_loss};
 use crate::optimize::repulsion::repulsion;
 use crate::optimize::{AdamOptions, DescentResult, Domain, PointObjective, adam};
 use crate::points::PointSet;
@@ -30,6 +31,9 @@ const DIRECTIONS: usize = 64;
 const SCORE_DIRECTIONS: usize = 512;
 /// Members per iteration for smooth families.
 const BATCH: usize = 128;
+/// Half-width of the ramp that smooths an indicator member's edge for its
+/// gradient, in mean spacings 1/√N ([`super::integrands::SquareIntegrand::edge_gradient`]).
+const EDGE_SPACINGS: f64 = 0.5;
 /// Members of the validation sample.
 const VALIDATION: usize = 1024;
 /// Streams of the descent's own draws (never the scoring seeds).
@@ -60,9 +64,8 @@ pub struct SquareTerm {
 /// `halfplanes+0.5*gaussians+0.1*blue`.
 ///
 /// # Errors
-/// [`FamilyError`] for a bad family, weight, or a family without
-/// gradients (disks, boxes and listed indicators can be scored, not
-/// targeted).
+/// [`FamilyError`] for a bad family, weight, or a listed family (its
+/// members have no gradient form: it can be scored, not targeted).
 pub fn parse_target(spec: &str) -> Result<Vec<SquareTerm>, FamilyError> {
     let fail = |reason: String| FamilyError {
         spec: spec.to_string(),
@@ -89,10 +92,10 @@ pub fn parse_target(spec: &str) -> Result<Vec<SquareTerm>, FamilyError> {
             continue;
         }
         let family = Family::parse(family.trim())?;
-        if !matches!(family, Family::HalfPlanes | Family::Gaussians { .. }) {
+        if matches!(family, Family::Listed { .. }) {
             return Err(fail(format!(
-                "{} can be scored but not targeted: its members are indicators without gradients \
-                 (targets: halfplanes, gaussians, blue)",
+                "{} can be scored but not targeted: listed integrands have no gradient form \
+                 (targets: halfplanes, gaussians, disks, boxes, blue)",
                 family.spec()
             )));
         }
@@ -145,9 +148,12 @@ impl SquareObjective {
                 TermKind::Family(family) => sampled_loss(
                     points,
                     family,
-                    self.seed ^ VALIDATION_STREAM,
-                    0,
-                    VALIDATION,
+                    Members {
+                        seed: self.seed ^ VALIDATION_STREAM,
+                        first: 0,
+                        count: VALIDATION,
+                    },
+                    0.0,
                     0.0,
                     None,
                 )
@@ -199,10 +205,13 @@ impl PointObjective for SquareObjective {
                 TermKind::Family(family) => sampled_loss(
                     points,
                     family,
-                    self.seed ^ TRAIN_STREAM,
-                    (t * BATCH) as u64,
-                    BATCH,
+                    Members {
+                        seed: self.seed ^ TRAIN_STREAM,
+                        first: (t * BATCH) as u64,
+                        count: BATCH,
+                    },
                     w,
+                    EDGE_SPACINGS / (points.len() as f64).sqrt(),
                     Some(gradient),
                 )
                 .expect("targets have gradients"),

@@ -19,18 +19,36 @@ use crate::variance::sum::NeumaierSum;
 /// Members per parallel task: fixed, so sums are thread-count independent.
 const CHUNK: usize = 16;
 
-/// L̂ over members `first..first + batch` of the sample drawn with `seed`;
-/// adds `weight`·∂L̂/∂x into `gradient` when given. `None` if a member has
-/// no gradient (indicators) and a gradient was asked for.
+/// Which members of a family sample: `first..first + count` of the sample
+/// drawn with `seed`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Members {
+    /// Seed of the sample.
+    pub seed: u64,
+    /// First member.
+    pub first: u64,
+    /// Members taken.
+    pub count: usize,
+}
+
+/// L̂ over `members` of `family`;
+/// adds `weight`·∂L̂/∂x into `gradient` when given. Indicators contribute
+/// through their edge gradient smoothed over half-width `edge`
+/// ([`super::integrands::SquareIntegrand::edge_gradient`]; 0: none). `None`
+/// if a member has no gradient of either kind and a gradient was asked for.
 pub fn sampled_loss(
     set: &PointSet,
     family: &Family,
-    seed: u64,
-    first: u64,
-    batch: usize,
+    members: Members,
     weight: f64,
+    edge: f64,
     gradient: Option<&mut [f64]>,
 ) -> Option<f64> {
+    let Members {
+        seed,
+        first,
+        count: batch,
+    } = members;
     let n = set.len() as f64;
     let want_gradient = gradient.is_some();
     let len = 2 * set.len();
@@ -54,7 +72,10 @@ pub fn sampled_loss(
                 if want_gradient {
                     let scale = 2.0 * e / n;
                     for (i, p) in set.points().enumerate() {
-                        let g = f.gradient([p[0], p[1]])?;
+                        let x = [p[0], p[1]];
+                        let g = f
+                            .gradient(x)
+                            .or_else(|| (edge > 0.0).then(|| f.edge_gradient(x, edge)).flatten())?;
                         grad[2 * i] += scale * g[0];
                         grad[2 * i + 1] += scale * g[1];
                     }
