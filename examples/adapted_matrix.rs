@@ -86,9 +86,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "seconds",
     ])?;
     println!(
-        "| N | integrand | lattice+descent / CMJ | descent from CMJ / CMJ | Sobol' / CMJ | jitter / CMJ | CMJ variance | design s |"
+        "| N | integrand | lattice+descent / CMJ | descent from CMJ / CMJ | Sobol' / CMJ | jitter / CMJ | Poisson disk / CMJ | CMJ variance | design s |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for &n in &sizes {
         for spec in targets() {
             let f = integrands::parse(&spec)?;

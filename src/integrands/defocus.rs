@@ -9,7 +9,9 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::{Disk, Gaussian, Integrand, IntegrandClass, LightField, PlaneWave, Rect, sinc_pi};
+use super::{
+    Disk, Gaussian, Integrand, IntegrandClass, IntegrandError, LightField, PlaneWave, Rect, sinc_pi,
+};
 use crate::points::wrap01;
 
 /// The 2D shape g of a defocus light field.
@@ -31,22 +33,42 @@ pub struct Defocus {
     g: Box<dyn Integrand>,
 }
 
+/// Smallest shape size: below it the disk radius or Gaussian σ underflows
+/// and no sample count resolves the shape.
+pub const MIN_SIZE: f64 = 1e-4;
+
 impl Defocus {
     /// Shape g of the given size, shear c.
-    pub fn new(shape: DefocusShape, size: f64, c: f64) -> Self {
+    ///
+    /// # Errors
+    /// [`IntegrandError::Value`] for a size outside [[`MIN_SIZE`], 1] (the
+    /// disk radius or Gaussian σ would underflow or leave the torus).
+    pub fn new(shape: DefocusShape, size: f64, c: f64) -> Result<Self, IntegrandError> {
+        if !(MIN_SIZE..=1.0).contains(&size) {
+            return Err(IntegrandError::Value {
+                integrand: "defocus",
+                key: "size",
+                value: size.to_string(),
+                expected: "a size in [1e-4, 1]".into(),
+            });
+        }
         let centre = [0.5, 0.5];
-        let g: Box<dyn Integrand> = match shape {
-            DefocusShape::Box => {
-                Box::new(Rect::new(size, size, centre, 0.0).expect("an axis-aligned square fits"))
-            }
-            DefocusShape::Disk => Box::new(
-                Disk::new(0.5 * size, centre).expect("a defocus size in (0, 1] gives r ≤ ½"),
-            ),
-            DefocusShape::Gaussian => {
-                Box::new(Gaussian::new(0.25 * size, 0.25 * size, 0.0, centre))
-            }
-        };
-        Defocus { shape, size, c, g }
+        let g: Box<dyn Integrand> =
+            match shape {
+                DefocusShape::Box => Box::new(Rect::new(size, size, centre, 0.0).map_err(|e| {
+                    IntegrandError::Value {
+                        integrand: "defocus",
+                        key: "size",
+                        value: size.to_string(),
+                        expected: e,
+                    }
+                })?),
+                DefocusShape::Disk => Box::new(Disk::new(0.5 * size, centre)?),
+                DefocusShape::Gaussian => {
+                    Box::new(Gaussian::new(0.25 * size, 0.25 * size, 0.0, centre))
+                }
+            };
+        Ok(Defocus { shape, size, c, g })
     }
 
     /// The shear c.

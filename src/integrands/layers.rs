@@ -23,12 +23,24 @@ pub struct Layers {
 impl Layers {
     /// Shape `shape` of `size` at shears `c1` and `c2`, the second with
     /// weight `mix` ∈ [0, 1].
-    pub fn new(shape: DefocusShape, size: f64, c1: f64, c2: f64, mix: f64) -> Self {
-        Layers {
-            layers: [Defocus::new(shape, size, c1), Defocus::new(shape, size, c2)],
+    ///
+    /// # Errors
+    /// As [`Defocus::new`].
+    pub fn new(
+        shape: DefocusShape,
+        size: f64,
+        c1: f64,
+        c2: f64,
+        mix: f64,
+    ) -> Result<Self, super::IntegrandError> {
+        Ok(Layers {
+            layers: [
+                Defocus::new(shape, size, c1)?,
+                Defocus::new(shape, size, c2)?,
+            ],
             mix,
             variance: OnceLock::new(),
-        }
+        })
     }
 
     fn weights(&self) -> [f64; 2] {

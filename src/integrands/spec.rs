@@ -94,7 +94,7 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
                 "box",
                 "g: box (side size), disk (diameter size) or gaussian (4σ = size), centred at (½,½)",
             ),
-            ("size", "0.3", "see shape, in (0, 1]"),
+            ("size", "0.3", "see shape, in [1e-4, 1]"),
             ("c", "0", "shear c = (F − d)/d"),
         ],
     },
@@ -104,7 +104,7 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
         summary: "two defocus layers (1 − mix)·g sheared by c1 + mix·g sheared by c2: a double wedge",
         params: &[
             ("shape", "box", "g: box, disk or gaussian, as for defocus"),
-            ("size", "0.3", "see defocus, in (0, 1]"),
+            ("size", "0.3", "see defocus, in [1e-4, 1]"),
             ("c1", "0.5", "shear of the first layer"),
             ("c2", "-0.2", "shear of the second layer, |c2 − c1| ≥ 0.05"),
             ("mix", "0.5", "weight of the second layer, in [0, 1]"),
@@ -230,6 +230,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
     }
     let p = Params { info, pairs };
     let unit = |v: f64| v > 0.0 && v <= 1.0;
+    let size = |v: f64| (super::defocus::MIN_SIZE..=1.0).contains(&v);
     Ok(match info.name {
         "cos" => Box::new(Cosine::new([p.integer("kx")?, p.integer("ky")?])),
         "disk" => Box::new(Disk::new(
@@ -274,9 +275,9 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
         )),
         "defocus" => Box::new(Defocus::new(
             p.shape()?,
-            p.number("size", unit, "a size in (0, 1]")?,
+            p.number("size", size, "a size in [1e-4, 1]")?,
             p.number("c", |c| c.abs() <= 16.0, "a shear in [-16, 16]")?,
-        )),
+        )?),
         "layers" => {
             let shear = |key| p.number(key, |c: f64| c.abs() <= 16.0, "a shear in [-16, 16]");
             let (c1, c2) = (shear("c1")?, shear("c2")?);
@@ -285,11 +286,11 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
             }
             Box::new(Layers::new(
                 p.shape()?,
-                p.number("size", unit, "a size in (0, 1]")?,
+                p.number("size", size, "a size in [1e-4, 1]")?,
                 c1,
                 c2,
                 p.number("mix", |m| (0.0..=1.0).contains(&m), "a weight in [0, 1]")?,
-            ))
+            )?)
         }
         _ => unreachable!("every registered integrand is built above"),
     })

@@ -39,3 +39,4 @@ pub fn assert_fails(args: &[&str], phrase: &str) {
     );
     assert!(!err.contains("panicked"), "{args:?}: {err}");
 }
+pub mod fuzz;
