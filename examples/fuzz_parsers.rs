@@ -24,7 +24,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::panic::set_hook(Box::new(|_| {}));
     let mut csv = csv::Writer::from_path(format!("{out}/fuzz.csv"))?;
     csv.write_record([
-        "parser", "inputs", "accepted", "panics", "slow", "slowest_ms", "seconds",
+        "parser",
+        "inputs",
+        "accepted",
+        "panics",
+        "slow",
+        "slowest_ms",
+        "seconds",
     ])?;
     println!("| parser | inputs | accepted | panics | slower than 1 s | slowest | wall time |");
     println!("|---|---|---|---|---|---|---|");

@@ -1,0 +1,86 @@
+//! Fault tests (issue 14 §4): a write killed with SIGKILL halfway leaves
+//! the old file whole, and the next write to the same path removes the
+//! killed run's temporary file.
+
+mod common;
+
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+fn temporaries(dir: &std::path::Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".old.csv.tmp-"))
+        .collect()
+}
+
+#[test]
+fn a_killed_write_leaves_the_old_file_whole_and_no_temporary_behind() {
+    let dir = common::temp_dir("sigkill");
+    let target = dir.join("old.csv");
+    let small = common::varspec(&[
+        "sample",
+        "random",
+        "-n",
+        "10",
+        "-o",
+        target.to_str().unwrap(),
+    ]);
+    assert!(small.status.success(), "{small:?}");
+    let before = std::fs::read(&target).unwrap();
+    // A write large enough (~80 MB) to be caught in the middle.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args(["sample", "random", "-n", "2000000", "--sets", "1", "-o"])
+        .arg(&target)
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let mut caught = false;
+    while start.elapsed() < Duration::from_secs(60) {
+        let writing = temporaries(&dir)
+            .iter()
+            .any(|name| std::fs::metadata(dir.join(name)).is_ok_and(|m| m.len() > 1 << 20));
+        if writing {
+            caught = true;
+            break;
+        }
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap(); // SIGKILL on Unix
+    child.wait().unwrap();
+    assert!(
+        caught,
+        "the write finished before it could be killed: nothing was tested"
+    );
+    assert_eq!(
+        std::fs::read(&target).unwrap(),
+        before,
+        "the old file changed although the write was killed"
+    );
+    assert!(
+        !temporaries(&dir).is_empty(),
+        "a killed run leaves its temporary (removed by the next write)"
+    );
+    let again = common::varspec(&[
+        "sample",
+        "random",
+        "-n",
+        "10",
+        "--seed",
+        "3",
+        "-o",
+        target.to_str().unwrap(),
+    ]);
+    assert!(again.status.success(), "{again:?}");
+    assert!(
+        temporaries(&dir).is_empty(),
+        "stale temporaries left: {:?}",
+        temporaries(&dir)
+    );
+    assert_ne!(std::fs::read(&target).unwrap(), before);
+}
