@@ -216,3 +216,66 @@ fn f32_tables_keep_every_point_in_its_stratum() {
     // Rounding to nearest would have failed this test: the check can fail.
     assert_eq!(f64::from((1.0f64 - 1e-12) as f32), 1.0);
 }
+
+/// The metadata's O(N²)-per-set predicted variances are left out, with a
+/// note, beyond the budget, and computed when asked.
+#[test]
+fn costly_predicted_variances_are_opt_in() {
+    // Its own folder: other tests here remove theirs when done.
+    let d = std::env::temp_dir().join(format!("varspec-tables-opt-in-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let path = d.join("large.csv");
+    let args = [
+        "tables",
+        "--sampler",
+        "random",
+        "-n",
+        "5000",
+        "--sets",
+        "4",
+        "--format",
+        "csv",
+        "-o",
+        path.to_str().unwrap(),
+    ];
+    let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("pass --variance"), "{err}");
+    assert!(sidecar(&path).predicted_variance.is_empty());
+    let small = d.join("small.csv");
+    varspec(&[
+        "tables",
+        "--sampler",
+        "random",
+        "-n",
+        "64",
+        "--sets",
+        "2",
+        "--format",
+        "csv",
+        "-o",
+        small.to_str().unwrap(),
+    ]);
+    assert_eq!(sidecar(&small).predicted_variance.len(), 4);
+    let forced = d.join("forced.csv");
+    varspec(&[
+        "tables",
+        "--sampler",
+        "random",
+        "-n",
+        "5000",
+        "--sets",
+        "1",
+        "--format",
+        "csv",
+        "--variance",
+        "-o",
+        forced.to_str().unwrap(),
+    ]);
+    assert_eq!(sidecar(&forced).predicted_variance.len(), 4);
+    let _ = std::fs::remove_dir_all(&d);
+}
