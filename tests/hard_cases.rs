@@ -195,3 +195,30 @@ fn defocus_has_no_spatial_form_and_says_so() {
         "{four:?} vs {e:?}"
     );
 }
+
+/// A set without points has no estimator: every predictor refuses it by
+/// name instead of returning NaN or a zero variance.
+#[test]
+fn predictors_refuse_sets_without_points() {
+    let f = integrands::parse("disk:r=0.3").unwrap();
+    let empty =
+        |_: usize| -> Result<PointSet, VarianceError> { Ok(PointSet::new(2, Vec::new()).unwrap()) };
+    for (name, result) in [
+        ("spatial", spatial(f.as_ref(), 2, empty).map(|e| e.variance)),
+        (
+            "fourier",
+            fourier(f.as_ref(), 16, 1e-9, 2, empty).map(|e| e.variance),
+        ),
+        (
+            "empirical",
+            empirical(f.as_ref(), 4, 1, empty).map(|e| e.variance),
+        ),
+    ] {
+        match result {
+            Err(e @ VarianceError::NoPoints { .. }) => {
+                assert!(e.to_string().contains("N = 0"), "{name}: {e}");
+            }
+            other => panic!("{name}: expected a refusal of N = 0, got {other:?}"),
+        }
+    }
+}

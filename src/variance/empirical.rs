@@ -107,6 +107,11 @@ where
         .map(|r| {
             let set = realization(r)?;
             let set = set.borrow();
+            if set.is_empty() {
+                return Err(VarianceError::NoPoints {
+                    what: "the empirical predictor",
+                });
+            }
             if set.dim() != d || d > 4 {
                 return Err(VarianceError::Dimension {
                     integrand: d,

@@ -124,6 +124,12 @@ where
     crate::spectrum::nufft::check_nufft_memory(&freqs)?;
     let first = realization(0)?;
     let n = first.len();
+    if n == 0 {
+        // Î = (1/N) Σ f(x_i) is undefined, and P_S = |S|²/N with it.
+        return Err(VarianceError::NoPoints {
+            what: "the Fourier predictor",
+        });
+    }
     if first.dim() != f.dim() {
         return Err(VarianceError::Dimension {
             integrand: f.dim(),

@@ -61,6 +61,14 @@ pub enum VarianceError {
         /// What went wrong.
         message: String,
     },
+    /// A set without points: Î = (1/N) Σ f(x_i) is undefined for N = 0.
+    #[error(
+        "{what} needs at least one point per set (the estimator (1/N) Σ f(x_i) is undefined for N = 0)"
+    )]
+    NoPoints {
+        /// The predictor.
+        what: &'static str,
+    },
     /// Too few realizations for a variance.
     #[error("{what} needs at least {needed} realizations, got {got}")]
     TooFew {

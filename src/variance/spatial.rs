@@ -58,7 +58,10 @@ pub fn spatial_variance(points: &PointSet, f: &dyn Integrand) -> Result<(f64, f6
         .autocov(&zero)
         .ok_or_else(|| VarianceError::NoAutocovariance { spec: f.spec() })?;
     if n == 0 {
-        return Ok((0.0, 0.0));
+        // Î = (1/N) Σ f(x_i) is undefined: no variance to report.
+        return Err(VarianceError::NoPoints {
+            what: "the spatial predictor",
+        });
     }
     let pair = |i: usize, j: usize| {
         let (a, b) = (points.point(i), points.point(j));
