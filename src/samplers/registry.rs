@@ -206,14 +206,18 @@ pub const SAMPLERS: &[SamplerInfo] = &[
     SamplerInfo {
         name: "sobol",
         aliases: &[],
-        summary: "Owen-scrambled Sobol' points (Joe & Kuo 2008 directions; hash-based nested uniform scrambling, Burley 2020)",
+        summary: "Owen-scrambled Sobol' points (Joe & Kuo 2008 directions; nested uniform scrambling, Owen 1995)",
         dims: DimRange {
             min: 1,
             max: sobol::MAX_DIM,
             default: 2,
         },
         count: "any N <= 2^32; (0,m,2)-net in dims 0,1 when N = 2^m",
-        params: &[],
+        params: &[ParamInfo {
+            key: "scramble",
+            default: "owen",
+            help: "owen: an independent flip per tree node; hash: Burley's faster Laine-Karras approximation (2020)",
+        }],
         build: sobol::from_config,
     },
     SamplerInfo {
