@@ -8,8 +8,9 @@
 //! [`super::halfplanes`] over q directions with a random offset per
 //! iteration (an unbiased estimate of the θ average: the set cannot fit a
 //! fixed set of directions); another family's term is the sample form of
-//! [`super::sampled`] on fresh members each iteration (disks and boxes
-//! through their edge gradients smoothed over half a spacing; a stochastic
+//! [`super::sampled`] on fresh members each iteration (disks, boxes and
+//! listed integrands through their gradients smoothed over half a spacing;
+//! a stochastic
 //! gradient on the family MSE itself). The best set is kept by a
 //! deterministic score: 512 directions for half-planes, a fixed validation
 //! sample for smooth families, both drawn apart from the members the final
@@ -64,8 +65,7 @@ pub struct SquareTerm {
 /// `halfplanes+0.5*gaussians+0.1*blue`.
 ///
 /// # Errors
-/// [`FamilyError`] for a bad family, weight, or a listed family (its
-/// members have no gradient form: it can be scored, not targeted).
+/// [`FamilyError`] for a bad family or weight.
 pub fn parse_target(spec: &str) -> Result<Vec<SquareTerm>, FamilyError> {
     let fail = |reason: String| FamilyError {
         spec: spec.to_string(),
@@ -92,13 +92,6 @@ pub fn parse_target(spec: &str) -> Result<Vec<SquareTerm>, FamilyError> {
             continue;
         }
         let family = Family::parse(family.trim())?;
-        if matches!(family, Family::Listed { .. }) {
-            return Err(fail(format!(
-                "{} can be scored but not targeted: listed integrands have no gradient form \
-                 (targets: halfplanes, gaussians, disks, boxes, blue)",
-                family.spec()
-            )));
-        }
         terms.push(SquareTerm {
             kind: TermKind::Family(family),
             weight,

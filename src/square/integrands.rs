@@ -291,6 +291,23 @@ impl SquareIntegrand for Catalogue {
     fn integral(&self) -> f64 {
         self.0.integral()
     }
+
+    /// Central differences of step h, one-sided at the border: the gradient
+    /// of f box-filtered over [x − h, x + h] along each axis, which is the
+    /// smoothed indicator's for an indicator and tends to ∇f for a smooth f.
+    fn edge_gradient(&self, x: [f64; 2], h: f64) -> Option<[f64; 2]> {
+        let mut g = [0.0; 2];
+        for (axis, out) in g.iter_mut().enumerate() {
+            let (mut lo, mut hi) = (x, x);
+            lo[axis] = (x[axis] - h).max(0.0);
+            hi[axis] = (x[axis] + h).min(crate::rng::PREV_ONE);
+            let span = hi[axis] - lo[axis];
+            if span > 0.0 {
+                *out = (self.0.eval(&hi) - self.0.eval(&lo)) / span;
+            }
+        }
+        Some(g)
+    }
 }
 
 #[cfg(test)]
