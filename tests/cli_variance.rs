@@ -138,7 +138,14 @@ fn converge_json_reports_slope_and_interval() {
     ]);
     let slope = v["slope"].as_f64().unwrap();
     let ci = v["slope_ci"].as_array().unwrap();
-    assert!(ci[0].as_f64().unwrap() <= slope && slope <= ci[1].as_f64().unwrap());
+    // An independent reference, not the fit's own centre: jitter on a
+    // discontinuous integrand decays as N^-1.5 (Pilleboue et al. 2015,
+    // Table 1); the 95% CI must hold it and be narrow enough to mean it.
+    let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+    assert!(
+        lo <= -1.5 && -1.5 <= hi && hi - lo < 0.4,
+        "slope {slope} with CI [{lo}, {hi}] against the theory's -1.5"
+    );
     assert_eq!(v["theory"].as_f64(), Some(-1.5));
     assert_eq!(
         v["points"][0]["n"].as_u64(),
