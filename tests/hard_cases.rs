@@ -42,7 +42,7 @@ fn agree_on(set: &PointSet, spec: &str, half: usize, realizations: usize) -> Agr
         four.truncation_bound,
         s.rounding_bound
     );
-    let se = (e.ci_high - e.ci_low) / (2.0 * 1.959_964);
+    let se = e.stderr;
     assert!(
         (e.variance - s.variance).abs() <= Z * se + s.rounding_bound,
         "{spec} N={}: empirical {:e} [{:e}, {:e}] vs spatial {:e}",
@@ -189,7 +189,7 @@ fn defocus_has_no_spatial_form_and_says_so() {
         |_| -> Result<PointSet, VarianceError> { Ok(set.clone()) },
     )
     .unwrap();
-    let se = (e.ci_high - e.ci_low) / (2.0 * 1.959_964);
+    let se = e.stderr;
     assert!(
         (four.variance - e.variance).abs() <= four.truncation_bound + Z * se,
         "{four:?} vs {e:?}"

@@ -667,7 +667,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                "line_slopes": p.lines, "first_line_share": p.first_line_share,
                "second_line_share": p.second_line_share, "one_line_misfit": p.one_line_misfit})
     };
-    let ci = |e: &varspec::variance::EmpiricalEstimate| json!({"variance": e.variance, "ci_low": e.ci_low, "ci_high": e.ci_high, "realizations": e.realizations});
+    let ci = |e: &varspec::variance::EmpiricalEstimate| json!({"variance": e.variance, "stderr": e.stderr, "ci_low": e.ci_low, "ci_high": e.ci_high, "realizations": e.realizations});
     let d = SENSITIVITY_STEP;
     let out = json!({
         "sampler": a.sampler, "integrand": f.spec(), "n": a.n, "sets": a.sets, "seed": a.seed,

@@ -160,7 +160,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         out.insert(
             "empirical".into(),
             json!({
-                "variance": e.variance, "ci_low": e.ci_low, "ci_high": e.ci_high, "mean": e.mean,
+                "variance": e.variance, "stderr": e.stderr, "ci_low": e.ci_low, "ci_high": e.ci_high, "mean": e.mean,
                 "realizations": e.realizations, "seconds": start.elapsed().as_secs_f64(),
             }),
         );

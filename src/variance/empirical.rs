@@ -22,6 +22,9 @@ const SHIFT_STREAM: u64 = 0x5348_4946_5453_4545;
 pub struct EmpiricalEstimate {
     /// Unbiased sample variance of Î.
     pub variance: f64,
+    /// Standard error of `variance`, √(Var[s²]) from the fourth central
+    /// moment (not clamped, unlike the interval).
+    pub stderr: f64,
     /// 95% confidence interval, lower end (≥ 0).
     pub ci_low: f64,
     /// 95% confidence interval, upper end.
@@ -141,6 +144,7 @@ where
     let half_width = 1.959_963_984_540_054 * var_of_var.sqrt();
     Ok(EmpiricalEstimate {
         variance,
+        stderr: var_of_var.sqrt(),
         ci_low: (variance - half_width).max(0.0),
         ci_high: variance + half_width,
         mean,
