@@ -56,6 +56,15 @@ impl Kept {
         }
     }
 
+    /// True when the returned set is the start: the exact form kept it, or
+    /// (without one) the descent's best score is the start's.
+    pub fn start_returned(&self) -> bool {
+        match self.exact {
+            Some(e) => e.kept_start,
+            None => self.descent.best_score >= self.descent.start_score,
+        }
+    }
+
     /// Exact variance of the returned set, if known.
     pub fn variance(&self) -> Option<f64> {
         self.exact
