@@ -65,7 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             tally.slowest.as_secs_f64() * 1e3
         );
         for (input, message) in &tally.failures {
-            eprintln!("  {}: panic `{message}` on {input:?}", target.name);
+            eprintln!("  {}: `{message}` on {input:?}", target.name);
         }
         failed |= tally.panics > 0 || tally.slow > 0;
     }

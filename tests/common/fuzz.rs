@@ -96,7 +96,7 @@ pub struct Tally {
     pub slow: u64,
     /// Slowest input.
     pub slowest: Duration,
-    /// The first panicking inputs with their messages.
+    /// The first panicking or slow inputs with their messages.
     pub failures: Vec<(String, String)>,
 }
 
@@ -190,6 +190,12 @@ pub fn fuzz(target: &Target, seed: u64, first: u64, count: u64) -> Tally {
         tally.slowest = tally.slowest.max(took);
         if took > LIMIT {
             tally.slow += 1;
+            if tally.failures.len() < 5 {
+                tally.failures.push((
+                    String::from_utf8_lossy(&input).into_owned(),
+                    format!("slow: {took:?}"),
+                ));
+            }
         }
         if let Ok(true) = outcome {
             tally.accepted += 1;
