@@ -266,7 +266,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     let exact: Option<Vec<f64>> = results.iter().map(Kept::variance).collect();
     let kept_start = results.iter().filter(|r| r.start_returned()).count();
     println!(
-        "{} set(s) of {} points optimized for {} in {seconds:.2} s ({} iterations for set 0); loss {:.4e}",
+        "{} set(s) of {} points for {} in {seconds:.2} s ({} iterations for set 0); loss {:.4e}",
         a.sets,
         a.n,
         a.target,
@@ -452,7 +452,9 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
 /// unshifted estimator, then score the result and the classic samplers on
 /// family members the descent never saw.
 fn points_square(a: PointsArgs) -> anyhow::Result<()> {
-    use varspec::square::design::{closest_pair_ratio, default_options, design, parse_target};
+    use varspec::square::design::{
+        TermKind, closest_pair_ratio, default_options, design, parse_target,
+    };
     use varspec::square::{Family, family_mse};
 
     if a.dim != 2 {
@@ -486,7 +488,15 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     let sets: Vec<_> = results.iter().map(|r| r.points.clone()).collect();
     write_atomic(&a.output, |w| write_point_sets(w, &sets, PointFormat::Csv))?;
     // Scores on members drawn with --score-seed.
-    let families = [Family::parse("halfplanes")?, Family::parse("gaussians")?];
+    // The peer's two families, and the target's own.
+    let mut families = vec![Family::parse("halfplanes")?, Family::parse("gaussians")?];
+    for term in &terms {
+        if let TermKind::Family(f) = &term.kind {
+            if !families.iter().any(|g| g.spec() == f.spec()) {
+                families.push(f.clone());
+            }
+        }
+    }
     let score = |sets: &[varspec::PointSet]| {
         let mut m = serde_json::Map::new();
         for f in &families {
