@@ -13,7 +13,8 @@
 use std::time::Instant;
 
 use varspec::integrands;
-use varspec::optimize::adapted::{design_sets, lattice_start};
+use varspec::optimize::adapted::design_sets;
+use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::rng::{set_rng, uniform};
 use varspec::samplers;
@@ -114,7 +115,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     ))
                 };
             let t = Instant::now();
-            let lattice = lattice_start(n, f.as_ref())?;
+            let lattice = best_lattice(n, f.as_ref())?;
             let search = t.elapsed().as_secs_f64();
             let (ours, seconds) = design(&lattice.lattice)?;
             let seconds = seconds + search;

@@ -6,7 +6,7 @@
 mod common;
 
 use varspec::integrands;
-use varspec::optimize::adapted::{design_sets, keep_lower_variance, lattice_start};
+use varspec::optimize::adapted::{design_sets, keep_lower_variance};
 use varspec::optimize::lattice::{best_lattice, lattices};
 use varspec::optimize::{DescentOptions, DescentResult, PointOptimizer, Target};
 use varspec::rng::set_rng;
@@ -95,7 +95,7 @@ fn adapted_design_beats_cmj_on_unseen_halfplanes() {
             let target = Target::parse(spec).unwrap();
             let optimizer =
                 PointOptimizer::new(2, &target, DescentOptions::for_target(n, 2, &target)).unwrap();
-            let start = lattice_start(n, f.as_ref()).unwrap();
+            let start = best_lattice(n, f.as_ref()).unwrap();
             let kept = design_sets(
                 &optimizer,
                 &start.lattice,

@@ -9,7 +9,9 @@ use varspec::PointSet;
 use varspec::optimize::AdamOptions;
 use varspec::rng::{set_rng, uniform};
 use varspec::samplers;
-use varspec::square::design::{closest_pair_ratio, default_options, design, parse_target};
+use varspec::square::design::{
+    SquareTerm, closest_pair_ratio, default_options, design, parse_target,
+};
 use varspec::square::halfplanes::{
     Projection, directional_loss, directions, halfplane_mse, pair_form,
 };
@@ -23,6 +25,21 @@ fn sets(name: &str, n: usize, count: u64, seed: u64) -> Vec<PointSet> {
     let s = samplers::build(name, n, Some(2), &[]).unwrap();
     (0..count)
         .map(|r| s.sample(&mut set_rng(seed, r)).unwrap())
+        .collect()
+}
+
+/// One design for `terms` from each start; set r's descent draws from
+/// seed `seed + r`.
+fn designed(
+    terms: &[SquareTerm],
+    starts: Vec<PointSet>,
+    seed: u64,
+    options: &AdamOptions,
+) -> Vec<PointSet> {
+    starts
+        .into_iter()
+        .enumerate()
+        .map(|(r, start)| design(terms, start, seed + r as u64, options, &|_, _| {}).points)
         .collect()
 }
 
@@ -155,20 +172,7 @@ fn blue_noise_for_the_square_beats_cmj_and_jitter_and_stays_blue() {
     // Reduced size: N = 256, 3 sets. Claims at N = 1024 and 4096 are in
     // results/square.
     let terms = parse_target("halfplanes+gaussians+16*blue").unwrap();
-    let designed: Vec<PointSet> = sets("jitter", 256, 3, 40)
-        .into_iter()
-        .enumerate()
-        .map(|(r, start)| {
-            design(
-                &terms,
-                start,
-                500 + r as u64,
-                &default_options(),
-                &|_, _| {},
-            )
-            .points
-        })
-        .collect();
+    let designed = designed(&terms, sets("jitter", 256, 3, 40), 500, &default_options());
     let cmj = sets("cmj", 256, 16, 41);
     let jitter = sets("jitter", 256, 16, 42);
     let (r, se) = ratio(score(&designed, "halfplanes"), score(&cmj, "halfplanes"));
@@ -198,11 +202,7 @@ fn gaussian_adapted_design_beats_owen_sobol() {
         iters: 600,
         ..default_options()
     };
-    let designed: Vec<PointSet> = sets("sobol", 256, 3, 50)
-        .into_iter()
-        .enumerate()
-        .map(|(r, start)| design(&terms, start, 600 + r as u64, &options, &|_, _| {}).points)
-        .collect();
+    let designed = designed(&terms, sets("sobol", 256, 3, 50), 600, &options);
     let sobol = sets("sobol", 256, 16, 51);
     let (gd, gd_se) = score(&designed, "gaussians");
     let (gs, gs_se) = score(&sobol, "gaussians");
@@ -222,20 +222,7 @@ fn disk_and_box_designs_beat_cmj_on_their_family() {
     let jitter = sets("jitter", 256, 16, 62);
     for family in ["disks", "boxes"] {
         let terms = parse_target(family).unwrap();
-        let designed: Vec<PointSet> = sets("jitter", 256, 2, 60)
-            .into_iter()
-            .enumerate()
-            .map(|(r, start)| {
-                design(
-                    &terms,
-                    start,
-                    700 + r as u64,
-                    &default_options(),
-                    &|_, _| {},
-                )
-                .points
-            })
-            .collect();
+        let designed = designed(&terms, sets("jitter", 256, 2, 60), 700, &default_options());
         let (rc, sc) = ratio(score(&designed, family), score(&cmj, family));
         assert!(
             rc + Z * sc < 1.0,
@@ -262,20 +249,7 @@ fn listed_family_design_fits_its_members() {
     .unwrap();
     let spec = format!("file:{}", list.display());
     let terms = parse_target(&spec).unwrap();
-    let designed: Vec<PointSet> = sets("jitter", 256, 2, 80)
-        .into_iter()
-        .enumerate()
-        .map(|(r, start)| {
-            design(
-                &terms,
-                start,
-                800 + r as u64,
-                &default_options(),
-                &|_, _| {},
-            )
-            .points
-        })
-        .collect();
+    let designed = designed(&terms, sets("jitter", 256, 2, 80), 800, &default_options());
     let family = Family::parse(&spec).unwrap();
     let ours = family_mse(&designed, &family, 3, 0).mse;
     let cmj = family_mse(&sets("cmj", 256, 16, 81), &family, 3, 0).mse;

@@ -224,58 +224,41 @@ fn costly_predicted_variances_are_opt_in() {
     // Its own folder: other tests here remove theirs when done.
     let d = std::env::temp_dir().join(format!("varspec-tables-opt-in-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
-    let path = d.join("large.csv");
-    let args = [
-        "tables",
-        "--sampler",
-        "random",
-        "-n",
-        "5000",
-        "--sets",
-        "4",
-        "--format",
-        "csv",
-        "-o",
-        path.to_str().unwrap(),
-    ];
-    let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    // A random-point CSV table of `sets` sets of `n` points, with `extra` options.
+    let table = |name: &str, n: &str, sets: &str, extra: &[&str]| {
+        let path = d.join(name);
+        let mut args = vec![
+            "tables",
+            "--sampler",
+            "random",
+            "-n",
+            n,
+            "--sets",
+            sets,
+            "--format",
+            "csv",
+        ];
+        args.extend_from_slice(extra);
+        let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
+            .args(&args)
+            .arg("-o")
+            .arg(&path)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (
+            sidecar(&path).predicted_variance.len(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (count, err) = table("large.csv", "5000", "4", &[]);
     assert!(err.contains("pass --variance"), "{err}");
-    assert!(sidecar(&path).predicted_variance.is_empty());
-    let small = d.join("small.csv");
-    varspec(&[
-        "tables",
-        "--sampler",
-        "random",
-        "-n",
-        "64",
-        "--sets",
-        "2",
-        "--format",
-        "csv",
-        "-o",
-        small.to_str().unwrap(),
-    ]);
-    assert_eq!(sidecar(&small).predicted_variance.len(), 4);
-    let forced = d.join("forced.csv");
-    varspec(&[
-        "tables",
-        "--sampler",
-        "random",
-        "-n",
-        "5000",
-        "--sets",
-        "1",
-        "--format",
-        "csv",
-        "--variance",
-        "-o",
-        forced.to_str().unwrap(),
-    ]);
-    assert_eq!(sidecar(&forced).predicted_variance.len(), 4);
+    assert_eq!(count, 0);
+    assert_eq!(table("small.csv", "64", "2", &[]).0, 4);
+    assert_eq!(table("forced.csv", "5000", "1", &["--variance"]).0, 4);
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -11,7 +11,8 @@ use serde_json::json;
 
 use super::{args, progress};
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
-use varspec::optimize::adapted::{Kept, design_sets, has_exact_form, lattice_start};
+use varspec::optimize::adapted::{Kept, design_sets};
+use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::rng::set_rng;
 use varspec::samplers;
@@ -164,7 +165,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         Target::Integrand(spec) => Some(varspec::integrands::parse(spec)?),
         _ => None,
     };
-    let exact_form = integrand.as_ref().filter(|f| has_exact_form(f.as_ref()));
+    let exact_form = integrand.as_ref().filter(|f| f.has_autocov());
     let init_name = a.init.clone().unwrap_or_else(|| {
         match &exact_form {
             Some(f) if a.dim == 2 && f.dim() == 2 => "lattice",
@@ -199,7 +200,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
                  (cos, disk, box, gaussian, halfplane)"
             );
         };
-        let found = lattice_start(a.n, f.as_ref())?;
+        let found = best_lattice(a.n, f.as_ref())?;
         println!(
             "start: the best of {} integration lattices of {} points (dual basis ({}, 0), ({}, {})), exact variance {:.4e}",
             found.candidates,

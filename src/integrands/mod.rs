@@ -45,6 +45,11 @@ pub trait Integrand: Send + Sync {
     /// The periodic autocovariance c_f(h), or `None` where no closed form is
     /// implemented (4D integrands).
     fn autocov(&self, h: &[f64]) -> Option<f64>;
+    /// True when [`Integrand::autocov`] has a closed form: the exact spatial
+    /// form of the variance applies (and the lattice search).
+    fn has_autocov(&self) -> bool {
+        self.autocov(&vec![0.0; self.dim()]).is_some()
+    }
     /// Radius beyond which c_f(h) = −I² exactly (the autocorrelation has
     /// compact support there), if any: lets the spatial predictor visit only
     /// close pairs and count the rest exactly.

@@ -11,7 +11,6 @@
 
 use rayon::prelude::*;
 
-use super::lattice::{LatticeDesign, best_lattice};
 use super::{DescentResult, OptimizeError, PointOptimizer};
 use crate::integrands::Integrand;
 use crate::points::PointSet;
@@ -86,7 +85,13 @@ pub fn keep_lower_variance(
     f: &dyn Integrand,
 ) -> Result<Kept, VarianceError> {
     let (before, before_rounding) = spatial_variance(&start, f)?;
-    let (after, after_rounding) = spatial_variance(&descent.points, f)?;
+    // A descent that found nothing lower returns its start itself: one
+    // O(N²) evaluation, not two.
+    let (after, after_rounding) = if descent.points == start {
+        (before, before_rounding)
+    } else {
+        spatial_variance(&descent.points, f)?
+    };
     let kept_start = if (before - after).abs() <= before_rounding + after_rounding {
         // Both at the spatial form's rounding floor (a smooth f on a good
         // set): the descent's own loss, a sum of nonnegative terms, decides.
@@ -108,23 +113,6 @@ pub fn keep_lower_variance(
             kept_start,
         }),
     })
-}
-
-/// True when `f` has the exact spatial form (a closed-form
-/// autocovariance) that [`keep_lower_variance`] and the lattice search need.
-pub fn has_exact_form(f: &dyn Integrand) -> bool {
-    f.autocov(&vec![0.0; f.dim()]).is_some()
-}
-
-/// The start of a design adapted to a 2D integrand with an exact form: the
-/// integration lattice of `n` points with the smallest exact variance
-/// ([`best_lattice`]; measured in results/optimize-adapted: 0.14× CMJ on a
-/// half-plane at N = 256 where the descent from CMJ reaches 0.29×).
-///
-/// # Errors
-/// See [`best_lattice`].
-pub fn lattice_start(n: usize, f: &dyn Integrand) -> Result<LatticeDesign, OptimizeError> {
-    best_lattice(n, f)
 }
 
 /// `sets` designs: realization r of `start` (stream (seed, r)) descended by

@@ -180,7 +180,7 @@ pub fn best_lattice(n: usize, f: &dyn Integrand) -> Result<LatticeDesign, Optimi
             "a lattice search needs 1 <= N <= {MAX_POINTS}, got N = {n}"
         )));
     }
-    if f.dim() != 2 || f.autocov(&[0.0, 0.0]).is_none() {
+    if f.dim() != 2 || !f.has_autocov() {
         return Err(OptimizeError::Target {
             spec: f.spec(),
             reason: "a lattice search needs a 2D integrand with a closed-form autocovariance \

@@ -101,6 +101,13 @@ pub struct Tally {
 }
 
 impl Tally {
+    /// Keeps an input and what went wrong with it (the first few).
+    fn record(&mut self, input: String, message: String) {
+        if self.failures.len() < 5 {
+            self.failures.push((input, message));
+        }
+    }
+
     /// Adds another tally.
     pub fn merge(&mut self, other: Tally) {
         self.inputs += other.inputs;
@@ -108,10 +115,8 @@ impl Tally {
         self.panics += other.panics;
         self.slow += other.slow;
         self.slowest = self.slowest.max(other.slowest);
-        for f in other.failures {
-            if self.failures.len() < 5 {
-                self.failures.push(f);
-            }
+        for (input, message) in other.failures {
+            self.record(input, message);
         }
     }
 }
@@ -190,28 +195,22 @@ pub fn fuzz(target: &Target, seed: u64, first: u64, count: u64) -> Tally {
         tally.slowest = tally.slowest.max(took);
         if took > LIMIT {
             tally.slow += 1;
-            if tally.failures.len() < 5 {
-                tally.failures.push((
-                    String::from_utf8_lossy(&input).into_owned(),
-                    format!("slow: {took:?}"),
-                ));
-            }
+            tally.record(
+                String::from_utf8_lossy(&input).into_owned(),
+                format!("slow: {took:?}"),
+            );
         }
         if let Ok(true) = outcome {
             tally.accepted += 1;
         }
         if let Err(payload) = outcome {
             tally.panics += 1;
-            if tally.failures.len() < 5 {
-                let message = payload
-                    .downcast_ref::<String>()
-                    .cloned()
-                    .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
-                    .unwrap_or_default();
-                tally
-                    .failures
-                    .push((String::from_utf8_lossy(&input).into_owned(), message));
-            }
+            let message = payload
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            tally.record(String::from_utf8_lossy(&input).into_owned(), message);
         }
     }
     tally
@@ -289,9 +288,11 @@ pub fn targets() -> Vec<Target> {
             seeds: lines(&["k,weight\n0,0\n10,0.5\n20,1\n", "k,weight\n1,1\n2,0.25\n"]),
             run: Box::new(|b| {
                 let path = scratch("radial");
-                std::fs::write(&path, b).is_ok()
+                let accepted = std::fs::write(&path, b).is_ok()
                     && varspec::optimize::Target::parse(&format!("radial:{}", path.display()))
-                        .is_ok()
+                        .is_ok();
+                let _ = std::fs::remove_file(&path);
+                accepted
             }),
         },
         Target {
