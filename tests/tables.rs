@@ -17,16 +17,15 @@ fn dir() -> PathBuf {
     d
 }
 
-fn varspec(args: &[&str]) {
+/// Runs `varspec args`, asserts success and returns its standard error.
+fn varspec(args: &[&str]) -> String {
     let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
         .args(args)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{args:?}: {err}");
+    err
 }
 
 fn sidecar(path: &Path) -> TableMetadata {
@@ -239,21 +238,9 @@ fn costly_predicted_variances_are_opt_in() {
             "csv",
         ];
         args.extend_from_slice(extra);
-        let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
-            .args(&args)
-            .arg("-o")
-            .arg(&path)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        (
-            sidecar(&path).predicted_variance.len(),
-            String::from_utf8_lossy(&out.stderr).into_owned(),
-        )
+        args.extend(["-o", path.to_str().unwrap()]);
+        let err = varspec(&args);
+        (sidecar(&path).predicted_variance.len(), err)
     };
     let (count, err) = table("large.csv", "5000", "4", &[]);
     assert!(err.contains("pass --variance"), "{err}");
