@@ -46,6 +46,9 @@ pub enum PointSetError {
         /// What is wrong.
         reason: &'static str,
     },
+    /// A point-process density that is not a positive finite number.
+    #[error("density {0} is not a positive finite number (the expected points per unit volume)")]
+    Density(f64),
     /// A shift vector of the wrong length or with values outside [0,1).
     #[error("shift {shift:?} is not a vector of {dim} values in [0, 1)")]
     Shift {
@@ -61,10 +64,18 @@ pub enum PointSetError {
 ///
 /// Every coordinate is finite and in [0, 1); `-0.0` is stored as `+0.0`.
 /// A set may be empty (N = 0) but never has d = 0.
+///
+/// A set drawn by a process whose number of points is random (isotropic
+/// jitter) carries the process's density λ, the expected number of points
+/// per unit volume: its estimator is Î = (1/λ) Σ f(x_j), unbiased where
+/// (1/N) Σ f(x_j) is not (Öztireli 2016, "Integration with stochastic
+/// point processes", ACM TOG 35(5), §4). Without a density the weight is
+/// 1/N (docs/mathematics.md §2, "A random number of points").
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointSet {
     dim: usize,
     coords: Vec<f64>,
+    density: Option<f64>,
 }
 
 /// Maps any finite real onto [0, 1) modulo 1.
@@ -124,7 +135,37 @@ impl PointSet {
             }
             *v += 0.0; // −0.0 + 0.0 = +0.0
         }
-        Ok(PointSet { dim, coords })
+        Ok(PointSet {
+            dim,
+            coords,
+            density: None,
+        })
+    }
+
+    /// The same points as a realization of a process of density λ
+    /// (expected points per unit volume), whose estimator weight is 1/λ.
+    ///
+    /// # Errors
+    /// [`PointSetError::Density`] unless λ is positive and finite.
+    pub fn with_density(mut self, density: f64) -> Result<Self, PointSetError> {
+        if !(density.is_finite() && density > 0.0) {
+            return Err(PointSetError::Density(density));
+        }
+        self.density = Some(density);
+        Ok(self)
+    }
+
+    /// The density λ of the process that drew the set, if its number of
+    /// points is random.
+    pub fn density(&self) -> Option<f64> {
+        self.density
+    }
+
+    /// The normalisation of the estimator and of the power spectrum: λ for
+    /// a set with a density, N otherwise (Î = Σ f(x_j)/intensity,
+    /// P_S(k) = |S(k)|²/intensity).
+    pub fn intensity(&self) -> f64 {
+        self.density.unwrap_or(self.len() as f64)
     }
 
     /// Number of points N.
@@ -182,6 +223,7 @@ impl PointSet {
         Ok(PointSet {
             dim: self.dim,
             coords,
+            density: self.density,
         })
     }
 
@@ -215,6 +257,7 @@ impl PointSet {
         Ok(PointSet {
             dim: dims.len(),
             coords,
+            density: self.density,
         })
     }
 }

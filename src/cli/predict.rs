@@ -102,6 +102,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     out.insert("integrand".into(), json!(f.spec()));
     out.insert("source".into(), json!(source.name()));
     out.insert("n".into(), json!(n));
+    out.insert("density".into(), json!(source.density()));
     out.insert("integral".into(), json!(f.integral()));
     out.insert(
         "estimator".into(),
@@ -130,7 +131,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 "fourier".into(),
                 json!({
                     "variance": e.variance, "truncation_bound": e.truncation_bound, "in_box": e.in_box,
-                    "tail": e.tail, "stderr": known_stderr(e.stderr, e.sets), "res": res, "sets": e.sets,
+                    "tail": e.tail, "count_term": e.count_term, "stderr": known_stderr(e.stderr, e.sets), "res": res, "sets": e.sets,
                     "seconds": seconds,
                 }),
             );
@@ -170,9 +171,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "{} on {} (N = {n}, {sets} sets), I = {}",
+        "{} on {} ({}, {sets} sets), I = {}",
         f.spec(),
         source.name(),
+        source.count_label(),
         f.integral()
     );
     for (key, extra) in [
@@ -223,7 +225,7 @@ fn square(a: &Args) -> anyhow::Result<()> {
     out.insert("domain".into(), json!("square"));
     out.insert(
         "estimator".into(),
-        json!("unshifted: mean of f over the set on [0,1)^2; error averaged over the family"),
+        json!("unshifted: sum of f over the set on [0,1)^2 divided by N (by the density for a random-count process); error averaged over the family"),
     );
     out.insert("family".into(), json!(family.spec()));
     out.insert("source".into(), json!(source.name()));
@@ -235,7 +237,8 @@ fn square(a: &Args) -> anyhow::Result<()> {
                "ci_high": brute.mse + 1.96 * brute.stderr, "members": brute.members, "member_seed": seed,
                "seconds": start.elapsed().as_secs_f64()}),
     );
-    if family == Family::HalfPlanes {
+    // The closed form weighs points by 1/N: not for random-count sets.
+    if family == Family::HalfPlanes && sets.iter().all(|s| s.density().is_none()) {
         let start = Instant::now();
         let q = 4096;
         let closed = sets.iter().map(|s| halfplane_mse(s, q)).sum::<f64>() / sets.len() as f64;
@@ -249,9 +252,10 @@ fn square(a: &Args) -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "{} on {} (N = {n}, {} sets), unshifted estimator on the square",
+        "{} on {} ({}, {} sets), unshifted estimator on the square",
         family.spec(),
         source.name(),
+        source.count_label(),
         sets.len()
     );
     println!(

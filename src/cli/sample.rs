@@ -92,6 +92,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
     let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|| bar.inc(1))?;
     bar.finish_and_clear();
+    if let Some(density) = sampler.density() {
+        // The files hold points only: the weight 1/λ has to be given back.
+        eprintln!(
+            "note: {name} draws a random number of points per set (density {density}); \
+             analyse the sets with --density {density} so the estimator weighs points by 1/{density}"
+        );
+    }
     let format = Format::resolve(a.format, a.output.as_deref());
     match &a.output {
         Some(path) => write_atomic(path, |w| format.write(w, &sets))?,

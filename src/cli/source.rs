@@ -33,6 +33,11 @@ pub struct SourceArgs {
     /// Analyse the projection onto these dimensions, e.g. 0,2 (XU) or 1,3 (YV).
     #[arg(long)]
     dims: Option<String>,
+    /// With a file of a random-count process (isotropic jitter): its
+    /// density λ, the expected points per unit volume; estimators weigh
+    /// points by 1/λ instead of 1/N.
+    #[arg(long, value_name = "LAMBDA")]
+    density: Option<f64>,
 }
 
 /// Resolved point sets, realization by realization.
@@ -79,13 +84,26 @@ impl SourceArgs {
                         path.display()
                     );
                 }
+                let mut sets = read_point_sets(path)?;
+                if let Some(density) = self.density {
+                    sets = sets
+                        .into_iter()
+                        .map(|s| s.with_density(density))
+                        .collect::<Result<_, _>>()
+                        .context("--density")?;
+                }
                 Source::File {
-                    sets: read_point_sets(path)?,
+                    sets,
                     dims: dims.clone(),
                     name: path.display().to_string(),
                 }
             }
             (None, Some(name)) => {
+                if self.density.is_some() {
+                    bail!(
+                        "--density applies to a point-set file; a sampler's sets carry their own density"
+                    );
+                }
                 if self.draw.sets() == 0 {
                     bail!("--sets must be at least 1");
                 }
@@ -139,6 +157,35 @@ impl Source {
         match self {
             Source::File { sets, .. } => sets[0].len(),
             Source::Sampler { sampler, .. } => sampler.points_per_set(),
+        }
+    }
+
+    /// The density λ of a random-count source (`--density` for a file),
+    /// `None` for a fixed N.
+    pub fn density(&self) -> Option<f64> {
+        match self {
+            Source::File { sets, .. } => sets[0].density(),
+            Source::Sampler { sampler, .. } => sampler.density(),
+        }
+    }
+
+    /// "N = 256", "N = 243 to 268, each set weighed by 1/N" for a file of
+    /// sets of different sizes, or "random N, density 256" for a
+    /// random-count source.
+    pub fn count_label(&self) -> String {
+        let sizes = match self {
+            Source::File { sets, .. } => sets
+                .iter()
+                .map(PointSet::len)
+                .fold((usize::MAX, 0), |(lo, hi), n| (lo.min(n), hi.max(n))),
+            Source::Sampler { sampler, .. } => (sampler.points_per_set(), sampler.points_per_set()),
+        };
+        match (self.density(), sizes) {
+            (Some(density), _) => format!("random N, density {density}"),
+            (None, (lo, hi)) if lo != hi => format!(
+                "N = {lo} to {hi}, each set weighed by 1/N; --density gives a random-count process's 1/λ"
+            ),
+            (None, (n, _)) => format!("N = {n}"),
         }
     }
 

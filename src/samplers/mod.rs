@@ -7,6 +7,7 @@
 //! output is identical for any number of threads.
 
 mod halton;
+mod isotropic_jitter;
 mod jitter;
 mod multijitter;
 mod nrooks;
@@ -19,6 +20,7 @@ mod sobol;
 mod sobol_table;
 
 pub use halton::Halton;
+pub use isotropic_jitter::IsotropicJitter;
 pub use jitter::{Jitter, StratumOffset};
 pub use multijitter::MultiJitter;
 pub use nrooks::NRooks;
@@ -40,8 +42,15 @@ use crate::spectrum::pair::PairSpectrum;
 pub trait Sampler: Send + Sync {
     /// Dimension d of every set.
     fn dim(&self) -> usize;
-    /// Number of points N of every set.
+    /// Number of points N of every set (the expected number for a sampler
+    /// with a [`density`](Sampler::density)).
     fn points_per_set(&self) -> usize;
+    /// The density λ of a sampler whose number of points is random
+    /// (isotropic jitter): its sets carry it and their estimator weight is
+    /// 1/λ. `None` for a fixed N.
+    fn density(&self) -> Option<f64> {
+        None
+    }
     /// Draws one realization from `rng`.
     ///
     /// # Errors

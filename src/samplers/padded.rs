@@ -23,9 +23,10 @@ impl Padded {
     /// Pairs `xy` and `uv`.
     ///
     /// # Errors
-    /// [`SamplerError::Param`] unless both are 2D with the same N.
+    /// [`SamplerError::Param`] unless both are 2D with the same fixed N.
     pub fn new(xy: Box<dyn Sampler>, uv: Box<dyn Sampler>) -> Result<Self, SamplerError> {
-        if xy.dim() != 2 || uv.dim() != 2 || xy.points_per_set() != uv.points_per_set() {
+        let fixed = xy.density().is_none() && uv.density().is_none();
+        if xy.dim() != 2 || uv.dim() != 2 || xy.points_per_set() != uv.points_per_set() || !fixed {
             return Err(SamplerError::Param {
                 sampler: "padded",
                 key: "xy/uv",
@@ -36,7 +37,7 @@ impl Padded {
                     uv.dim(),
                     uv.points_per_set()
                 ),
-                expected: "two 2D samplers of the same N".into(),
+                expected: "two 2D samplers of the same fixed N (a random-count sampler such as isotropic-jitter cannot be paired)".into(),
             });
         }
         Ok(Padded { xy, uv })

@@ -3,7 +3,10 @@
 //! (`varspec sample --list`) and [`build`] read.
 
 use super::{Sampler, SamplerError};
-use super::{halton, jitter, multijitter, nrooks, optimized, padded, poisson_disk, random, sobol};
+use super::{
+    halton, isotropic_jitter, jitter, multijitter, nrooks, optimized, padded, poisson_disk, random,
+    sobol,
+};
 
 /// The dimensions a sampler supports and the one it uses by default.
 #[derive(Debug, Clone, Copy)]
@@ -87,6 +90,19 @@ pub const SAMPLERS: &[SamplerInfo] = &[
         count: "N = m^d",
         params: &[],
         build: jitter::uniform_jitter_from_config,
+    },
+    SamplerInfo {
+        name: "isotropic-jitter",
+        aliases: &["ijitter"],
+        summary: "jittered grid of spacing 1/m, randomly rotated and shifted, clipped to the square: a random count of mean m^2, weight 1/lambda (Oztireli 2016)",
+        dims: DimRange {
+            min: 2,
+            max: 2,
+            default: 2,
+        },
+        count: "N = m^2, the expected count (each set's count is random)",
+        params: &[],
+        build: isotropic_jitter::from_config,
     },
     SamplerInfo {
         name: "nrooks",

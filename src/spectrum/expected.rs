@@ -74,7 +74,9 @@ pub fn check_memory(freqs: &FrequencyBox, method: Method, res: usize) -> Result<
     Ok(())
 }
 
-/// E[N·P_S(k)] over `sets` realizations on the box `freqs`; realization r is
+/// E[N·P_S(k)] over `sets` realizations on the box `freqs` (E[|S(k)|²/λ]
+/// for sets with a density λ, which tends to 1 far from the origin just the
+/// same); realization r is
 /// `realization(r)` (a set from a file, or a fresh sampler draw), projected
 /// by the caller as needed. Parallel over realizations in fixed chunks.
 ///
@@ -149,7 +151,13 @@ where
                         }
                         _ => s.copy_from_slice(&dft::sample_spectrum(&points, &freqs)),
                     }
-                    let n = points.len().max(1) as f64;
+                    // |S|²/N, or |S|²/λ for a random-count set (an empty one
+                    // has S = 0 and power 0 either way).
+                    let n = if points.is_empty() {
+                        1.0
+                    } else {
+                        points.intensity()
+                    };
                     for ((acc, p), v) in sum.iter_mut().zip(power.iter_mut()).zip(s.iter()) {
                         *p = v.norm_sqr() / n;
                         *acc += *p;

@@ -1,5 +1,5 @@
 //! The score of point sets on the square: the mean squared error of the
-//! unshifted estimator Î = (1/N) Σ_i f(x_i) over the members of a family,
+//! unshifted estimator Î = (1/N) Σ_i f(x_i) (1/λ for a random-count set) over the members of a family,
 //! by brute force (each member evaluated at every point), with a standard
 //! error over the members. This is the peer's yardstick (UTK's integration
 //! tests: the average of (Î − I)² over a database of integrands) and the
@@ -46,7 +46,7 @@ pub fn family_mse(sets: &[PointSet], family: &Family, members: usize, seed: u64)
                     for p in set.points() {
                         sum.add(f.eval([p[0], p[1]]));
                     }
-                    let e = sum.value() / set.len() as f64 - integral;
+                    let e = sum.value() / set.intensity() - integral;
                     e * e
                 })
                 .collect()

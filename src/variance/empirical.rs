@@ -35,7 +35,8 @@ pub struct EmpiricalEstimate {
     pub realizations: usize,
 }
 
-/// Î for one realization under shift `s`.
+/// Î = Σ f(x_j + s)/intensity for one realization under shift `s` (the
+/// intensity is N, or the density λ of a random-count process).
 fn estimate(f: &dyn Integrand, set: &PointSet, shift: &[f64]) -> f64 {
     let d = set.dim();
     let mut y = [0.0; 4];
@@ -47,7 +48,7 @@ fn estimate(f: &dyn Integrand, set: &PointSet, shift: &[f64]) -> f64 {
         }
         acc.add(f.eval(&y[..d]));
     }
-    acc.value() / set.len() as f64
+    acc.value() / set.intensity()
 }
 
 /// The empirical variance of Î over R realizations; realization r is
@@ -110,7 +111,7 @@ where
         .map(|r| {
             let set = realization(r)?;
             let set = set.borrow();
-            if set.is_empty() {
+            if set.is_empty() && set.density().is_none() {
                 return Err(VarianceError::NoPoints {
                     what: "the empirical predictor",
                 });

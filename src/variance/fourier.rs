@@ -23,6 +23,11 @@
 //! the outside and the fluctuation term uses Σ_(k∉B) P_f² ≤ T² instead: the
 //! bound is then wide, and says so. The bound is an estimate from the data,
 //! not a theorem: it assumes the shell represents the frequencies beyond it.
+//!
+//! Sets with a density λ (a random number of points, weight 1/λ) use
+//! P_S = |S|²/λ and λ in place of N throughout, plus the k = 0 term
+//! E[(N/λ − 1)²]·I², the variance the random count adds (docs/mathematics.md
+//! §2, "A random number of points"); it is 0 for a fixed N.
 
 use rayon::prelude::*;
 
@@ -39,7 +44,7 @@ const LATTICE_SPIKE: f64 = 20.0;
 /// The Fourier prediction.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FourierEstimate {
-    /// Σ_(k∈B\0) E[P_S] P_f + tail/N.
+    /// Σ_(k∈B\0) E[P_S] P_f + tail/N + count term.
     pub variance: f64,
     /// Standard error of `variance` over realizations (0 for one).
     pub stderr: f64,
@@ -49,6 +54,9 @@ pub struct FourierEstimate {
     pub in_box: f64,
     /// The Parseval tail term T/N.
     pub tail: f64,
+    /// The k = 0 term E[(N/λ − 1)²]·I² of a random-count process (0 for a
+    /// fixed N).
+    pub count_term: f64,
     /// The box half-width h.
     pub half: usize,
     /// Realizations averaged.
@@ -99,8 +107,8 @@ pub struct FourierParts {
     pub spectrum: Spectrum,
     /// P_f(k) on the box, in box order.
     pub integrand_power: Vec<f64>,
-    /// N.
-    pub n: usize,
+    /// The normalisation: N, or the density λ of a random-count process.
+    pub intensity: f64,
 }
 
 /// As [`fourier`], keeping the spectra.
@@ -124,7 +132,7 @@ where
     crate::spectrum::nufft::check_nufft_memory(&freqs)?;
     let first = realization(0)?;
     let n = first.len();
-    if n == 0 {
+    if n == 0 && first.density().is_none() {
         // Î = (1/N) Σ f(x_i) is undefined, and P_S = |S|²/N with it.
         return Err(VarianceError::NoPoints {
             what: "the Fourier predictor",
@@ -137,6 +145,9 @@ where
         });
     }
     let pf = integrand_power(f, &freqs);
+    let intensity = first.intensity();
+    // Every set's N, to form the count term E[(N/λ − 1)²]·I² exactly.
+    let counts = std::sync::Mutex::new(vec![0usize; sets]);
     let zero = freqs.zero_index();
     // Each realization's in-box sum Σ_(k≠0) N·P_S(k)·P_f(k), for the standard error.
     let in_box_of = |power: &[f64]| {
@@ -159,12 +170,17 @@ where
             } else {
                 realization(r)?
             };
-            if set.len() != n {
-                return Err(VarianceError::MixedSizes {
-                    first: n,
-                    other: set.len(),
-                });
+            match (first.density(), set.density()) {
+                (Some(a), Some(b)) if a == b => {}
+                (None, None) if set.len() == n => {}
+                _ => {
+                    return Err(VarianceError::MixedSizes {
+                        first: n,
+                        other: set.len(),
+                    });
+                }
             }
+            counts.lock().expect("no panics while held")[r] = set.len();
             Ok(set)
         },
         &in_box_of,
@@ -192,7 +208,11 @@ where
             mass.add(w);
         }
     }
-    let nf = n as f64;
+    let nf = intensity;
+    let counts = counts.into_inner().expect("no panics while held");
+    let i2 = f.integral() * f.integral();
+    let count_bias = |c: usize| (c as f64 / intensity - 1.0).powi(2) * i2;
+    let count_term = super::sum::sum(counts.iter().map(|&c| count_bias(c))) / sets as f64;
     let tail_mass = (f.variance() - mass.value()).max(0.0);
     let (bias, spread, pf_max) = if shell.is_empty() {
         (1.0, 0.0, 0.0)
@@ -223,19 +243,26 @@ where
     };
     let in_box = in_box.value() / nf;
     let tail = tail_mass / nf;
+    // Per-set values (in-box part and count term) for the standard error.
+    let per_set: Vec<f64> = per_set
+        .iter()
+        .zip(&counts)
+        .map(|(v, &c)| v / nf + count_bias(c))
+        .collect();
     let (_, stderr) = super::spatial::mean_and_stderr(&per_set);
     Ok(FourierParts {
         estimate: FourierEstimate {
-            variance: in_box + tail,
-            stderr: stderr / nf,
+            variance: in_box + tail + count_term,
+            stderr,
             truncation_bound,
             in_box,
             tail,
+            count_term,
             half,
             sets,
         },
         spectrum,
         integrand_power: pf,
-        n,
+        intensity,
     })
 }

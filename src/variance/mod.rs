@@ -46,7 +46,10 @@ pub enum VarianceError {
         spec: String,
     },
     /// Realizations of different sizes in a Fourier prediction.
-    #[error("the Fourier predictor needs every set to have the same N (found {first} and {other})")]
+    #[error(
+        "the Fourier predictor needs every set to have the same N (found {first} and {other}), \
+         or to come from one random-count process of known density (point files: --density)"
+    )]
     MixedSizes {
         /// One size.
         first: usize,

@@ -23,7 +23,8 @@ use super::sum::NeumaierSum;
 /// The radial prediction.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RadialEstimate {
-    /// (1/N) Σ_r n_r P̄_S(r) P̄_f(r) + tail/N.
+    /// (1/N) Σ_r n_r P̄_S(r) P̄_f(r) + tail/N (+ the Fourier form's count
+    /// term for a random-count process).
     pub variance: f64,
     /// Cauchy–Schwarz bound on |radial − Fourier| inside the box:
     /// (1/N) Σ_r n_r σ_S(r) σ_f(r).
@@ -72,9 +73,9 @@ pub fn radial_from(parts: &FourierParts) -> RadialEstimate {
         // n·σ_S·σ_f with population standard deviations.
         bound.add((sq_s[r] * sq_f[r]).sqrt());
     }
-    let nf = parts.n as f64;
+    let nf = parts.intensity;
     RadialEstimate {
-        variance: in_box.value() / nf + parts.estimate.tail,
+        variance: in_box.value() / nf + parts.estimate.tail + parts.estimate.count_term,
         anisotropy_bound: bound.value() / nf,
         truncation_bound: parts.estimate.truncation_bound,
         rings: rings - 1,

@@ -4,7 +4,11 @@
 //! Var_s[Î] = (1/N²) Σ_(i,j) c_f(x_i − x_j)
 //!          = (1/N²) [N·c_f(0) + 2 Σ_(i<j) c_f(x_i − x_j)],
 //!
-//! exact with no truncation. Terms are autocovariances (never
+//! exact with no truncation. For a set with a density λ (a random number of
+//! points, weight w = 1/λ) the mean squared error of Î = w Σ f(x_j + s) is
+//! w² Σ_(i,j) c_f(x_i − x_j) + (wN − 1)² I², whose mean over realizations is
+//! the variance (docs/mathematics.md §2, "A random number of points"); with
+//! w = 1/N the second term is exactly 0. Terms are autocovariances (never
 //! autocorrelations minus I²), summed with Neumaier compensation in fixed
 //! row blocks reduced in order, so the result is identical for any thread
 //! count. For integrands whose autocorrelation has compact support of
@@ -39,8 +43,9 @@ pub struct SpatialEstimate {
     pub sets: usize,
 }
 
-/// Var_s[Î] for one point set under uniform random shifts, with the bound
-/// on its rounding error (see [`SpatialEstimate::rounding_bound`]).
+/// Var_s[Î] for one point set under uniform random shifts (its mean squared
+/// error E_s[(Î − I)²] for a set with a density), with the bound on its
+/// rounding error (see [`SpatialEstimate::rounding_bound`]).
 ///
 /// # Errors
 /// [`VarianceError::Dimension`], or [`VarianceError::NoAutocovariance`] for
@@ -57,8 +62,9 @@ pub fn spatial_variance(points: &PointSet, f: &dyn Integrand) -> Result<(f64, f6
     let c0 = f
         .autocov(&zero)
         .ok_or_else(|| VarianceError::NoAutocovariance { spec: f.spec() })?;
-    if n == 0 {
-        // Î = (1/N) Σ f(x_i) is undefined: no variance to report.
+    if n == 0 && points.density().is_none() {
+        // Î = (1/N) Σ f(x_i) is undefined: no variance to report (with a
+        // density, Î = 0 and the loops below are empty).
         return Err(VarianceError::NoPoints {
             what: "the spatial predictor",
         });
@@ -131,8 +137,13 @@ pub fn spatial_variance(points: &PointSet, f: &dyn Integrand) -> Result<(f64, f6
     let mut v = NeumaierSum::default();
     v.add(n as f64 * c0);
     v.add(2.0 * off_diagonal);
-    let n2 = n as f64 * n as f64;
-    let rounding = 4.0 * f64::EPSILON * (n as f64 * c0.abs() + 2.0 * off_abs) / n2;
+    // (wN − 1)² I²: zero for w = 1/N, the random count's cost otherwise.
+    let intensity = points.intensity();
+    let i2 = f.integral() * f.integral();
+    let count_bias = (n as f64 - intensity).powi(2) * i2;
+    v.add(count_bias);
+    let n2 = intensity * intensity;
+    let rounding = 4.0 * f64::EPSILON * (n as f64 * c0.abs() + 2.0 * off_abs + count_bias) / n2;
     // A variance is non-negative; a negative total is rounding noise, within
     // `rounding` of 0.
     Ok(((v.value() / n2).max(0.0), rounding))
