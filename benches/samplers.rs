@@ -6,10 +6,11 @@
 
 use std::hint::black_box;
 use std::time::Duration;
+use varspec::registry;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use varspec::registry::SAMPLERS;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, SAMPLERS};
 
 fn throughput(c: &mut Criterion) {
     let mut group = c.benchmark_group("samplers");
@@ -20,7 +21,7 @@ fn throughput(c: &mut Criterion) {
     // `varspec optimize points --curve`, not as points per second.
     for info in SAMPLERS.iter().filter(|s| s.name != "blue-noise") {
         for d in [2, 4] {
-            let Ok(sampler) = samplers::build(info.name, 4096, Some(d), &[]) else {
+            let Ok(sampler) = registry::build(info.name, 4096, Some(d), &[]) else {
                 continue;
             };
             group.throughput(Throughput::Elements(4096));
@@ -33,7 +34,7 @@ fn throughput(c: &mut Criterion) {
             });
         }
     }
-    let pd = samplers::build("poisson-disk", 10_000, Some(2), &[]).unwrap();
+    let pd = registry::build("poisson-disk", 10_000, Some(2), &[]).unwrap();
     group.throughput(Throughput::Elements(10_000));
     let mut set = 0;
     group.bench_function("poisson-disk/2d/10000", |b| {

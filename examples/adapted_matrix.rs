@@ -11,6 +11,7 @@
 //! Writes `matrix.csv` to the folder and prints a markdown table.
 
 use std::time::Instant;
+use varspec::registry;
 
 use varspec::integrands;
 use varspec::optimize::adapted::design_sets;
@@ -95,7 +96,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let f = integrands::parse(&spec)?;
             let mut classic = Vec::new();
             for name in ["cmj", "sobol", "jitter", "poisson-disk"] {
-                let s = samplers::build(name, n, Some(2), &[])?;
+                let s = registry::build(name, n, Some(2), &[])?;
                 let e = spatial(f.as_ref(), 64, |r| -> Result<_, VarianceError> {
                     Ok(s.sample(&mut set_rng(0x5c0e, r as u64))?)
                 })?;
@@ -119,7 +120,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let search = t.elapsed().as_secs_f64();
             let (ours, seconds) = design(&lattice.lattice)?;
             let seconds = seconds + search;
-            let cmj_sampler = samplers::build("cmj", n, Some(2), &[])?;
+            let cmj_sampler = registry::build("cmj", n, Some(2), &[])?;
             let (old, old_seconds) = design(cmj_sampler.as_ref())?;
             let mut row = |design: &str, v: f64, se: f64, s: f64| {
                 csv.write_record([

@@ -12,8 +12,9 @@ use varspec::integrands;
 use varspec::optimize::projections::{ProjectionObjective, parse_projections};
 use varspec::optimize::shear::Sheared;
 use varspec::optimize::{AdamOptions, Domain, adam};
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, Sampler};
+use varspec::samplers::Sampler;
 use varspec::square::design::closest_pair_ratio;
 use varspec::variance::{VarianceError, empirical_shifting};
 
@@ -29,7 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let c = -f.light_field().ok_or("a light field")?.layer_shears()[0][0];
     let target = format!("xy:family:disks;uv:family:disks;{spec}");
     let terms = parse_projections(&target, n)?;
-    let umj = samplers::build("umj", n, Some(4), &[])?;
+    let umj = registry::build("umj", n, Some(4), &[])?;
     let options = AdamOptions {
         iters,
         rel_tol: 0.0,

@@ -16,8 +16,9 @@
 //! ```
 
 use std::time::Instant;
+use varspec::registry;
 
-use varspec::samplers::{self, Sampler};
+use varspec::samplers::Sampler;
 use varspec::scene::Scene;
 use varspec::scene::analysis::SampleShear;
 use varspec::scene::image::GreyImage;
@@ -29,7 +30,7 @@ const RENDERS: usize = 16;
 
 /// A reference image: the mean of 2 renders of Sobol at 4096 spp.
 fn reference_image(scene: &Scene) -> Result<GreyImage, Box<dyn std::error::Error>> {
-    let sobol = samplers::build("sobol", 4096, Some(4), &[])?;
+    let sobol = registry::build("sobol", 4096, Some(4), &[])?;
     let none = vec![SampleShear::NONE; pixel_count(scene)];
     let a = render(scene, sobol.as_ref(), &none, 900, 0)?;
     let b = render(scene, sobol.as_ref(), &none, 900, 1)?;
@@ -119,7 +120,7 @@ fn dof(out: &str) -> Result<(), Box<dyn std::error::Error>> {
         candidates.push(SampleShear::Position([a, a]));
     }
     for spp in [16, 64, 256] {
-        let sampler = samplers::build("umj", spp, Some(4), &[])?;
+        let sampler = registry::build("umj", spp, Some(4), &[])?;
         // The best global transformation on 2 renders of another seed.
         let mut best = (SampleShear::NONE, f64::INFINITY);
         for &c in &candidates {
@@ -217,7 +218,7 @@ fn shadows(out: &str) -> Result<(), Box<dyn std::error::Error>> {
             "umj",
             "sobol",
         ] {
-            let sampler = samplers::build(name, 16, Some(4), &[])?;
+            let sampler = registry::build(name, 16, Some(4), &[])?;
             let none = vec![SampleShear::NONE; pixel_count(&scene)];
             let row = evaluate(&scene, sampler.as_ref(), &none, 3, RENDERS, &reference)?;
             // Relative RMS error over the lit pixels: √(mean MSE) / mean value.

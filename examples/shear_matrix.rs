@@ -9,10 +9,10 @@
 //! ```
 
 use std::time::Instant;
+use varspec::registry;
 
 use varspec::integrands;
 use varspec::optimize::shear::{ObjectiveOptions, ShearObjective, search_shear, spectral_start};
-use varspec::samplers;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args()
@@ -55,7 +55,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for spec in &specs {
         for n in [64, 256, 1024] {
             let f = integrands::parse(spec)?;
-            let sampler = samplers::build("umj", n, Some(4), &[])?;
+            let sampler = registry::build("umj", n, Some(4), &[])?;
             let start = Instant::now();
             let spectral = spectral_start(f.as_ref(), 64, 2.0);
             let mut starts = spectral.candidates();

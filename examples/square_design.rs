@@ -8,8 +8,8 @@
 //! Arguments: target, start sampler, N, iterations, initial step.
 
 use varspec::optimize::{AdamOptions, Domain, adam};
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
 use varspec::square::design::{SquareObjective, parse_target};
 use varspec::square::{Family, family_mse};
 
@@ -22,7 +22,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let iters: usize = arg(4, "300").parse()?;
     let step: f64 = arg(5, "0.05").parse()?;
     let sets = 4;
-    let (sampler, n) = samplers::build_nearest(&init, n, Some(2), &[])?;
+    let (sampler, n) = registry::build_nearest(&init, n, Some(2), &[])?;
     let families = [Family::parse("halfplanes")?, Family::parse("gaussians")?];
     let options = AdamOptions {
         iters,

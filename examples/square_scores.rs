@@ -6,8 +6,8 @@
 //! cargo run --release --example square_scores
 //! ```
 
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
 use varspec::square::halfplanes::halfplane_mse;
 use varspec::square::{Family, family_mse};
 
@@ -16,7 +16,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let families = [Family::parse("gaussians")?, Family::parse("halfplanes")?];
     println!("N = {n}, 16 sets, 1024 members per family (seed 99)");
     for name in ["random", "jitter", "cmj", "sobol", "halton", "poisson-disk"] {
-        let (sampler, n_used) = samplers::build_nearest(name, n, Some(2), &[])?;
+        let (sampler, n_used) = registry::build_nearest(name, n, Some(2), &[])?;
         let sets: Vec<_> = (0..16)
             .map(|r| sampler.sample(&mut set_rng(1, r)))
             .collect::<Result<_, _>>()?;

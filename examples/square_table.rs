@@ -11,10 +11,10 @@
 //! ```
 
 use std::time::Instant;
+use varspec::registry;
 
 use varspec::PointSet;
 use varspec::rng::{set_rng, uniform};
-use varspec::samplers;
 use varspec::square::design::{closest_pair_ratio, default_options, design, parse_target};
 use varspec::square::{Family, family_mse};
 
@@ -55,7 +55,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (index, &n) in ns.iter().enumerate() {
         let mut rows: Vec<(String, Vec<PointSet>, f64)> = Vec::new();
         for name in ["random", "jitter", "cmj", "sobol", "halton", "poisson-disk"] {
-            let (s, _) = samplers::build_nearest(name, n, Some(2), &[])?;
+            let (s, _) = registry::build_nearest(name, n, Some(2), &[])?;
             let clock = Instant::now();
             let sets: Vec<PointSet> = (0..16)
                 .map(|r| s.sample(&mut set_rng(5, r)))
@@ -63,7 +63,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             rows.push((name.into(), sets, clock.elapsed().as_secs_f64() / 16.0));
         }
         // The torus blue noise (the disk family), as the issue measured it.
-        let torus = samplers::build("blue-noise", n, Some(2), &[])?;
+        let torus = registry::build("blue-noise", n, Some(2), &[])?;
         let clock = Instant::now();
         let sets: Vec<PointSet> = (0..4)
             .map(|r| torus.sample(&mut set_rng(6, r)))
@@ -79,7 +79,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ("gaussians", "sobol"),
         ] {
             let terms = parse_target(target)?;
-            let start = samplers::build(init, n, Some(2), &[])?;
+            let start = registry::build(init, n, Some(2), &[])?;
             let clock = Instant::now();
             let mut sets = Vec::new();
             for r in 0..8u64 {

@@ -11,8 +11,8 @@
 //! Arguments: N, then samplers (name or name:key=value,...) beside jitter and cmj.
 
 use varspec::integrands::{self, Integrand};
+use varspec::registry;
 use varspec::rng::{set_rng, uniform};
-use varspec::samplers;
 use varspec::spectrum::{FrequencyBox, Method, expected_power};
 use varspec::variance::fourier::integrand_power;
 
@@ -49,7 +49,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let drawn: Vec<varspec::PointSet> = if name.ends_with(".csv") {
             varspec::io::read_point_sets(std::path::Path::new(name))?
         } else {
-            let (s, _) = samplers::build_nearest(name, n, Some(2), &[])?;
+            let (s, _) = registry::build_nearest(name, n, Some(2), &[])?;
             let count = if name.starts_with("blue") { 4 } else { 16 };
             (0..count)
                 .map(|r| s.sample(&mut set_rng(11, r)))

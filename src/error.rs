@@ -1,6 +1,7 @@
 //! The crate-wide error type: one enum wrapping each module's typed errors, so
 //! callers can match on the exact condition (docs/architecture.md, "Conventions").
 
+use crate::io::WriteError;
 use crate::io::pointfile::PointFileError;
 use crate::points::PointSetError;
 use crate::samplers::SamplerError;
@@ -18,12 +19,6 @@ pub enum Error {
     #[error(transparent)]
     Sampler(#[from] SamplerError),
     /// An output file could not be written.
-    #[error("cannot write {path}: {cause}")]
-    Write {
-        /// The file that was being written.
-        path: std::path::PathBuf,
-        /// The underlying I/O error (in the message, so not repeated as a
-        /// source when error chains are printed).
-        cause: std::io::Error,
-    },
+    #[error(transparent)]
+    Write(#[from] WriteError),
 }

@@ -3,17 +3,17 @@
 //!
 //! The crate is library first; the `varspec` binary is a thin command-line
 //! layer over it (see docs/architecture.md). Data flows one way:
-//! a [`samplers::Sampler`] produces [`points::PointSet`]s, which analyses and
+//! a [`samplers::Sampler`] (built by name through [`registry`]) produces [`points::PointSet`]s, which analyses and
 //! reports consume. Randomness only enters through an explicit seeded
 //! generator handed down ([`rng`]), so a seed fixes every output bit for any
 //! number of threads.
 //!
 //! ```
-//! use varspec::{integrands, samplers, variance};
+//! use varspec::{integrands, registry, variance};
 //! use varspec::rng::set_rng;
 //!
 //! // 256 jittered points, one realization from stream (seed 7, set 0).
-//! let jitter = samplers::build("jitter", 256, Some(2), &[]).unwrap();
+//! let jitter = registry::build("jitter", 256, Some(2), &[]).unwrap();
 //! let points = jitter.sample(&mut set_rng(7, 0)).unwrap();
 //!
 //! // The variance of the shift-randomized estimator on a disk, exactly
@@ -36,15 +36,18 @@ pub mod io;
 pub mod memory;
 pub mod neighbours;
 pub mod optimize;
+pub mod optimized;
 pub mod points;
 pub mod polygon;
 pub mod quadrature;
+pub mod registry;
 pub mod report;
 pub mod rng;
 pub mod samplers;
 pub mod scene;
 pub mod spectrum;
 pub mod square;
+pub mod sum;
 pub mod tour;
 pub mod variance;
 

@@ -396,7 +396,7 @@ fn outputs_are_checked_before_the_work_starts() {
 fn list_names_every_sampler_with_constraints() {
     let out = varspec(&["sample", "--list"]);
     let text = String::from_utf8(out.stdout).unwrap();
-    for info in varspec::samplers::SAMPLERS {
+    for info in varspec::registry::SAMPLERS {
         assert!(
             text.contains(info.name) && text.contains(info.count),
             "{} missing from --list",

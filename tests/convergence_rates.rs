@@ -6,8 +6,8 @@
 //! exclude −1 — so the test can fail both ways.
 
 use varspec::integrands::{self, Integrand};
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
 use varspec::variance::{VarianceError, fit_slope, fourier, spatial, theoretical_rate};
 
 /// Square N (jitter needs m²), 64 to 1024: five points, three degrees of freedom.
@@ -24,7 +24,7 @@ fn slope_ci(sampler: &str, f: &dyn Integrand) -> (f64, (f64, f64)) {
     let ns_used: &[usize] = if large { &NS_LARGE } else { &NS };
     let mut vars = Vec::new();
     for &n in ns_used {
-        let s = samplers::build(sampler, n, Some(2), &[]).unwrap();
+        let s = registry::build(sampler, n, Some(2), &[]).unwrap();
         let realization = |r: usize| -> Result<_, VarianceError> {
             Ok(s.sample(&mut set_rng(n as u64, r as u64))?)
         };

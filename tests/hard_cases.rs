@@ -4,8 +4,8 @@
 
 use varspec::PointSet;
 use varspec::integrands;
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
 use varspec::variance::{VarianceError, empirical, fourier, spatial};
 
 /// z for the empirical comparisons (per-check two-sided rate 6.8e-6).
@@ -60,7 +60,7 @@ fn agree_on(set: &PointSet, spec: &str, half: usize, realizations: usize) -> Agr
 }
 
 fn jitter(n: usize, seed: u64) -> PointSet {
-    samplers::build("jitter", n, Some(2), &[])
+    registry::build("jitter", n, Some(2), &[])
         .unwrap()
         .sample(&mut set_rng(seed, 0))
         .unwrap()
@@ -133,7 +133,7 @@ fn cosine_at_frequency_4000_3000() {
 #[test]
 fn variance_1e14_below_the_squared_integral() {
     // A regular grid integrates a smooth bump almost exactly: Var/I² ~ 3e-15.
-    let set = samplers::build("regular", 256, Some(2), &[])
+    let set = registry::build("regular", 256, Some(2), &[])
         .unwrap()
         .sample(&mut set_rng(0, 0))
         .unwrap();
@@ -165,7 +165,7 @@ fn one_two_and_duplicate_points() {
 #[test]
 fn defocus_has_no_spatial_form_and_says_so() {
     let f = integrands::parse("defocus:shape=disk,size=0.3,c=0.6").unwrap();
-    let set = samplers::build("umj", 64, Some(4), &[])
+    let set = registry::build("umj", 64, Some(4), &[])
         .unwrap()
         .sample(&mut set_rng(0, 0))
         .unwrap();

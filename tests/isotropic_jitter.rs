@@ -5,6 +5,7 @@
 //! (z = 3.29); each message prints the interval.
 
 use varspec::integrands;
+use varspec::registry;
 use varspec::samplers::{self, Sampler};
 use varspec::variance::{VarianceError, empirical, fourier, spatial};
 use varspec::{PointSet, rng::set_rng};
@@ -17,7 +18,7 @@ fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Vec<PointSet> {
 
 #[test]
 fn counts_are_random_with_mean_lambda_and_points_inside_the_square() {
-    let sampler = samplers::build("isotropic-jitter", 256, None, &[]).unwrap();
+    let sampler = registry::build("isotropic-jitter", 256, None, &[]).unwrap();
     assert_eq!(sampler.density(), Some(256.0));
     // (Seed 7 gave a mean 3.4 standard errors low, p ≈ 7e-4; 100,000 sets
     // at seed 21 then gave z = −1.77 at λ = 16 and +0.08 at λ = 64: chance,
@@ -42,7 +43,7 @@ fn the_weight_one_over_lambda_is_unbiased() {
     // Unshifted estimator of an integrand on the square: the process is
     // stationary, so E[(1/λ) Σ f(x_j)] = I for any f; check the linear
     // and a quadratic moment.
-    let sampler = samplers::build("isotropic-jitter", 64, None, &[]).unwrap();
+    let sampler = registry::build("isotropic-jitter", 64, None, &[]).unwrap();
     let sets = draw(sampler.as_ref(), 11, 20000);
     for (name, f, integral) in [
         ("x", (|p: &[f64]| p[0]) as fn(&[f64]) -> f64, 0.5),
@@ -66,7 +67,7 @@ fn the_weight_one_over_lambda_is_unbiased() {
 
 #[test]
 fn spatial_fourier_and_empirical_forms_agree_with_a_random_count() {
-    let sampler = samplers::build("isotropic-jitter", 256, None, &[]).unwrap();
+    let sampler = registry::build("isotropic-jitter", 256, None, &[]).unwrap();
     let f = integrands::parse("disk:r=0.27,cx=0.4,cy=0.55").unwrap();
     let sets = draw(sampler.as_ref(), 5, 256);
     let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(sets[r].clone()) };
@@ -138,14 +139,14 @@ fn axis_alignment(sets: &[PointSet], radius: f64) -> (f64, f64) {
 fn pair_directions_are_isotropic_where_jitter_is_not() {
     // The random rotation is what makes the process isotropic: without it
     // (jitter) close pairs prefer the diagonals.
-    let sampler = samplers::build("isotropic-jitter", 256, None, &[]).unwrap();
+    let sampler = registry::build("isotropic-jitter", 256, None, &[]).unwrap();
     let (iso, iso_se) = axis_alignment(&draw(sampler.as_ref(), 13, 300), 1.0 / 16.0);
     assert!(
         iso.abs() <= Z * iso_se,
         "isotropic jitter: mean cos 4φ = {iso} outside 0 ± {} (99.9%)",
         Z * iso_se
     );
-    let jitter = samplers::build("jitter", 256, None, &[]).unwrap();
+    let jitter = registry::build("jitter", 256, None, &[]).unwrap();
     let (jit, jit_se) = axis_alignment(&draw(jitter.as_ref(), 13, 300), 1.0 / 16.0);
     assert!(
         jit < -Z * jit_se,
@@ -155,11 +156,11 @@ fn pair_directions_are_isotropic_where_jitter_is_not() {
 
 #[test]
 fn random_counts_are_refused_where_they_cannot_be_used() {
-    let e = samplers::build("padded:xy=isotropic-jitter,uv=jitter", 256, None, &[])
+    let e = registry::build("padded:xy=isotropic-jitter,uv=jitter", 256, None, &[])
         .err()
         .expect("a random count cannot be paired");
     assert!(e.to_string().contains("random-count"), "{e}");
-    let e = samplers::build("isotropic-jitter", 250, None, &[])
+    let e = registry::build("isotropic-jitter", 250, None, &[])
         .err()
         .unwrap();
     assert!(e.to_string().contains("225 or 256"), "{e}");

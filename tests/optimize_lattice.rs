@@ -9,8 +9,9 @@ use varspec::integrands;
 use varspec::optimize::adapted::{design_sets, keep_lower_variance};
 use varspec::optimize::lattice::{best_lattice, lattices};
 use varspec::optimize::{DescentOptions, DescentResult, PointOptimizer, Target};
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, Sampler};
+use varspec::samplers::Sampler;
 use varspec::variance::{VarianceError, spatial, spatial_variance};
 
 /// The lattice rule's N-term form equals the generic all-pairs spatial
@@ -57,7 +58,7 @@ fn the_lower_exact_variance_is_kept() {
     let f = integrands::parse("halfplane:angle=33,offset=0.1").unwrap();
     let lattice = best_lattice(64, f.as_ref()).unwrap().lattice;
     let good = lattice.sample(&mut set_rng(1, 0)).unwrap();
-    let bad = samplers::build("random", 64, Some(2), &[])
+    let bad = registry::build("random", 64, Some(2), &[])
         .unwrap()
         .sample(&mut set_rng(1, 0))
         .unwrap();
@@ -106,7 +107,7 @@ fn adapted_design_beats_cmj_on_unseen_halfplanes() {
             )
             .unwrap();
             let ours = kept[0].variance().unwrap();
-            let cmj = samplers::build("cmj", n, Some(2), &[]).unwrap();
+            let cmj = registry::build("cmj", n, Some(2), &[]).unwrap();
             let c = spatial(f.as_ref(), 64, |r| -> Result<_, VarianceError> {
                 Ok(cmj.sample(&mut set_rng(17, r as u64))?)
             })

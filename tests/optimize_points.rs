@@ -3,8 +3,8 @@
 
 use varspec::PointSet;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
 
 #[test]
 fn gradient_matches_central_differences() {
@@ -15,7 +15,7 @@ fn gradient_matches_central_differences() {
         (4, "power:2.5"),
     ] {
         let n = 40;
-        let p = samplers::build("random", n, Some(d), &[])
+        let p = registry::build("random", n, Some(d), &[])
             .unwrap()
             .sample(&mut set_rng(9, d as u64))
             .unwrap();
@@ -55,13 +55,13 @@ fn blue_noise_beats_jitter_on_unseen_disks_and_boxes() {
     let n = 1024;
     let target = Target::parse("family:disks").unwrap();
     let opt = PointOptimizer::new(2, &target, DescentOptions::for_target(n, 2, &target)).unwrap();
-    let start = samplers::build("random", n, Some(2), &[])
+    let start = registry::build("random", n, Some(2), &[])
         .unwrap()
         .sample(&mut set_rng(0, 0))
         .unwrap();
     let result = opt.optimize(start, &|_, _| {});
     assert!(result.losses.len() > 100, "the descent must run");
-    let jitter = samplers::build("jitter", n, Some(2), &[]).unwrap();
+    let jitter = registry::build("jitter", n, Some(2), &[]).unwrap();
     let mut ratios = Vec::new();
     for spec in [
         "disk:r=0.1,cx=0.31",
@@ -103,14 +103,14 @@ fn integrand_adapted_set_beats_cmj_on_its_integrand() {
     let n = 256;
     let target = Target::parse(spec).unwrap();
     let opt = PointOptimizer::new(2, &target, DescentOptions::for_target(n, 2, &target)).unwrap();
-    let start = samplers::build("random", n, Some(2), &[])
+    let start = registry::build("random", n, Some(2), &[])
         .unwrap()
         .sample(&mut set_rng(1, 0))
         .unwrap();
     let result = opt.optimize(start, &|_, _| {});
     let f = integrands::parse(spec).unwrap();
     let ours = spatial_variance(&result.points, f.as_ref()).unwrap().0;
-    let cmj = samplers::build("cmj", n, Some(2), &[]).unwrap();
+    let cmj = registry::build("cmj", n, Some(2), &[]).unwrap();
     let c = spatial(f.as_ref(), 64, |r| -> Result<_, VarianceError> {
         Ok(cmj.sample(&mut set_rng(6, r as u64))?)
     })
@@ -131,7 +131,7 @@ fn optimization_is_deterministic_and_descends() {
     o.iters = 200;
     let opt = PointOptimizer::new(2, &target, o).unwrap();
     let start = || {
-        samplers::build("random", 64, Some(2), &[])
+        registry::build("random", 64, Some(2), &[])
             .unwrap()
             .sample(&mut set_rng(2, 0))
             .unwrap()

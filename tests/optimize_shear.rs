@@ -9,8 +9,9 @@ use varspec::integrands;
 use varspec::optimize::shear::{
     ObjectiveOptions, ShearObjective, Sheared, search_shear, shear_set, spectral_start,
 };
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, Sampler};
+use varspec::samplers::Sampler;
 use varspec::variance::{VarianceError, empirical_shifting};
 
 /// Two-sided z for a per-check false-alarm rate of 1e-4.
@@ -67,7 +68,7 @@ fn closed_form_objective_matches_brute_force_variances() {
         ),
     ] {
         let f = integrands::parse(spec).unwrap();
-        let s = samplers::build(sampler, n, Some(4), &[]).unwrap();
+        let s = registry::build(sampler, n, Some(4), &[]).unwrap();
         let (objective, _) = objective(f.as_ref(), s.as_ref());
         for shear in shears {
             let j = objective.value(shear[0], shear[1]);
@@ -96,7 +97,7 @@ fn search_finds_the_light_field_shear_with_its_sign() {
     ] {
         let f = integrands::parse(spec).unwrap();
         let c = f.light_field().unwrap().layer_shears()[0][0];
-        let s = samplers::build("umj", n, Some(4), &[]).unwrap();
+        let s = registry::build("umj", n, Some(4), &[]).unwrap();
         let (objective, start) = objective(f.as_ref(), s.as_ref());
         let found = search_shear(&objective, &start, 2.0).unwrap();
         for (axis, a) in found.shear.iter().enumerate() {
@@ -120,7 +121,7 @@ fn search_finds_the_light_field_shear_with_its_sign() {
 #[test]
 fn the_search_gain_holds_on_fresh_realizations() {
     let f = integrands::parse("defocus:shape=disk,size=0.33,c=-0.52").unwrap();
-    let s = samplers::build("umj", 256, Some(4), &[]).unwrap();
+    let s = registry::build("umj", 256, Some(4), &[]).unwrap();
     let (objective, start) = objective(f.as_ref(), s.as_ref());
     let found = search_shear(&objective, &start, 2.0).unwrap();
     let (before, se_before) = brute_force(f.as_ref(), s.as_ref(), [0.0, 0.0], 4000);
@@ -136,7 +137,7 @@ fn the_search_gain_holds_on_fresh_realizations() {
 #[test]
 fn no_shear_is_kept_when_nothing_is_better() {
     let f = integrands::parse("defocus:shape=box,size=0.3,c=0").unwrap();
-    let s = samplers::build("umj", 64, Some(4), &[]).unwrap();
+    let s = registry::build("umj", 64, Some(4), &[]).unwrap();
     let (objective, start) = objective(f.as_ref(), s.as_ref());
     let found = search_shear(&objective, &start, 2.0).unwrap();
     assert!(
@@ -172,7 +173,7 @@ fn double_wedges_are_told_from_single_layers() {
         let start = spectral_start(f.as_ref(), 64, 2.0);
         assert!(start.double_wedge, "{spec}: {:?}", start.planes[0]);
         // The best single shear is never worse than none.
-        let s = samplers::build("umj", 64, Some(4), &[]).unwrap();
+        let s = registry::build("umj", 64, Some(4), &[]).unwrap();
         let objective = ShearObjective::new(
             f.as_ref(),
             s.as_ref(),
@@ -189,7 +190,7 @@ fn double_wedges_are_told_from_single_layers() {
 fn estimated_halves_report_their_standard_error() {
     // Poisson disk has no closed form: the (u, v) half is estimated.
     let f = integrands::parse("defocus:shape=disk,size=0.3,c=0.4").unwrap();
-    let s = samplers::build("padded:xy=cmj,uv=poisson-disk", 64, Some(4), &[]).unwrap();
+    let s = registry::build("padded:xy=cmj,uv=poisson-disk", 64, Some(4), &[]).unwrap();
     let (objective, start) = objective(f.as_ref(), s.as_ref());
     assert!(objective.realizations()[1] >= 64);
     let found = search_shear(&objective, &start, 2.0).unwrap();
@@ -204,8 +205,8 @@ fn estimated_halves_report_their_standard_error() {
 
 #[test]
 fn integrands_and_samplers_without_the_structure_are_refused() {
-    let umj = samplers::build("umj", 16, Some(4), &[]).unwrap();
-    let sobol = samplers::build("sobol", 16, Some(4), &[]).unwrap();
+    let umj = registry::build("umj", 16, Some(4), &[]).unwrap();
+    let sobol = registry::build("sobol", 16, Some(4), &[]).unwrap();
     let defocus = integrands::parse("defocus:c=0.5").unwrap();
     let disk = integrands::parse("disk:r=0.2").unwrap();
     let err = ShearObjective::new(
@@ -228,7 +229,7 @@ fn integrands_and_samplers_without_the_structure_are_refused() {
     .unwrap()
     .to_string();
     assert!(err.contains("light-field"), "{err}");
-    let set = samplers::build("cmj", 16, Some(2), &[])
+    let set = registry::build("cmj", 16, Some(2), &[])
         .unwrap()
         .sample(&mut set_rng(0, 0))
         .unwrap();

@@ -4,8 +4,8 @@
 //! E[N·P_S(k)] = 1 − sinc²(πk_x/m)·sinc²(πk_y/m).
 
 use rustfft::num_complex::Complex64;
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
 use varspec::spectrum::pair::EmpiricalPairs;
 
 /// Two-sided z for a per-check false-alarm rate of 1e-5 (≈ 600 checks keep
@@ -25,7 +25,7 @@ const PAIRS: &[([f64; 2], [f64; 2])] = &[
 ];
 
 fn check(name: &str, n: usize, params: &[(String, String)]) {
-    let sampler = samplers::build(name, n, Some(2), params).unwrap();
+    let sampler = registry::build(name, n, Some(2), params).unwrap();
     let exact = sampler
         .pair_spectrum()
         .unwrap_or_else(|| panic!("{name} has a closed form"));
@@ -77,7 +77,7 @@ fn closed_forms_match_monte_carlo() {
 #[test]
 fn jitter_power_is_pilleboue_s_formula() {
     let m = 8;
-    let jitter = samplers::build("jitter", m * m, Some(2), &[]).unwrap();
+    let jitter = registry::build("jitter", m * m, Some(2), &[]).unwrap();
     let spectrum = jitter.pair_spectrum().unwrap();
     let sinc = |x: f64| if x == 0.0 { 1.0 } else { x.sin() / x };
     for kx in -20i64..=20 {

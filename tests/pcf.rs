@@ -1,7 +1,8 @@
 //! Pair correlation: white noise is 1, Poisson disk is empty below its radius.
 
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, packing_radius};
+use varspec::samplers::packing_radius;
 use varspec::spectrum::pcf::pair_correlation;
 
 #[test]
@@ -11,7 +12,7 @@ fn random_points_have_unit_pair_correlation_within_ci() {
     // 1 for r ≥ 5σ. Per-radius mean over 200 sets within z = 5 SE.
     let n = 512;
     let sigma = 0.2 * packing_radius(n, 2);
-    let sampler = samplers::build("random", n, Some(2), &[]).unwrap();
+    let sampler = registry::build("random", n, Some(2), &[]).unwrap();
     let per_set: Vec<Vec<f64>> = (0..200)
         .map(|r| {
             let set = sampler.sample(&mut set_rng(3, r)).unwrap();
@@ -42,7 +43,7 @@ fn random_points_have_unit_pair_correlation_within_ci() {
 fn poisson_disk_pair_correlation_vanishes_below_its_radius() {
     let n = 1024;
     let params = [("radius".to_string(), "0.75".to_string())];
-    let sampler = samplers::build("poisson-disk", n, Some(2), &params).unwrap();
+    let sampler = registry::build("poisson-disk", n, Some(2), &params).unwrap();
     let sets: Vec<_> = (0..8)
         .map(|r| sampler.sample(&mut set_rng(4, r)).unwrap())
         .collect();
@@ -64,7 +65,7 @@ fn poisson_disk_pair_correlation_vanishes_below_its_radius() {
 
 #[test]
 fn bad_pcf_parameters_are_errors() {
-    let set = samplers::build("random", 10, Some(2), &[])
+    let set = registry::build("random", 10, Some(2), &[])
         .unwrap()
         .sample(&mut set_rng(0, 0))
         .unwrap();

@@ -2,6 +2,7 @@
 //! kind of malformed input.
 
 use std::path::Path;
+use varspec::registry;
 
 use varspec::PointSet;
 use varspec::io::pointfile::{
@@ -9,7 +10,6 @@ use varspec::io::pointfile::{
 };
 use varspec::io::{PointFormat, read_point_sets, write_atomic, write_point_sets};
 use varspec::rng::{PREV_ONE, set_rng};
-use varspec::samplers;
 
 fn parse(text: &str) -> Result<Vec<PointSet>, PointFileError> {
     parse_point_sets(text.as_bytes(), Path::new("in.csv"))
@@ -30,7 +30,7 @@ fn line_problem(text: &str) -> (usize, LineProblem, String) {
 
 #[test]
 fn round_trip_is_bit_exact_in_both_formats() {
-    let sampler = samplers::build("random", 50, Some(3), &[]).unwrap();
+    let sampler = registry::build("random", 50, Some(3), &[]).unwrap();
     let mut sets: Vec<PointSet> = (0..3)
         .map(|r| sampler.sample(&mut set_rng(9, r)).unwrap())
         .collect();
@@ -273,7 +273,7 @@ fn npy_by_hand(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> 
 fn npy_point_sets_round_trip_and_read_what_numpy_writes() {
     let dir = std::env::temp_dir().join(format!("varspec-npy-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let sampler = samplers::build("random", 5, Some(3), &[]).unwrap();
+    let sampler = registry::build("random", 5, Some(3), &[]).unwrap();
     let sets: Vec<PointSet> = (0..2)
         .map(|r| sampler.sample(&mut set_rng(4, r)).unwrap())
         .collect();

@@ -7,8 +7,9 @@ use varspec::integrands;
 use varspec::optimize::projections::{ProjectionObjective, parse_projections};
 use varspec::optimize::shear::Sheared;
 use varspec::optimize::{AdamOptions, Domain, PointObjective, adam};
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, Sampler};
+use varspec::samplers::Sampler;
 use varspec::square::design::closest_pair_ratio;
 use varspec::variance::{VarianceError, empirical_shifting, spatial_variance};
 
@@ -31,7 +32,7 @@ fn a_light_field_term_is_the_torus_variance_of_its_sheared_projection() {
     let f = integrands::parse("defocus:shape=disk,size=0.34,c=-0.37").unwrap();
     let g = integrands::parse("disk:r=0.17").unwrap();
     let terms = parse_projections("defocus:shape=disk,size=0.34,c=-0.37", 64).unwrap();
-    let set = samplers::build("umj", 64, Some(4), &[])
+    let set = registry::build("umj", 64, Some(4), &[])
         .unwrap()
         .sample(&mut set_rng(8, 0))
         .unwrap();
@@ -51,7 +52,7 @@ fn the_gradient_matches_finite_differences() {
         16,
     )
     .unwrap();
-    let set = samplers::build("random", 16, Some(4), &[])
+    let set = registry::build("random", 16, Some(4), &[])
         .unwrap()
         .sample(&mut set_rng(2, 0))
         .unwrap();
@@ -87,7 +88,7 @@ fn a_designed_set_beats_sheared_umj_and_stays_blue() {
     let spec = "defocus:shape=disk,size=0.3,c=0.45";
     let f = integrands::parse(spec).unwrap();
     let terms = parse_projections(&format!("xy:family:disks;uv:family:disks;{spec}"), 64).unwrap();
-    let umj = samplers::build("umj", 64, Some(4), &[]).unwrap();
+    let umj = registry::build("umj", 64, Some(4), &[]).unwrap();
     let options = AdamOptions {
         iters: 400,
         rel_tol: 0.0,

@@ -4,12 +4,12 @@
 //! N-rooks on an axis-aligned band.
 
 use varspec::integrands;
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
 use varspec::variance::{VarianceError, fit_slope, fourier_parts, radial_from, spatial};
 
 fn draw(name: &str, n: usize, sets: usize) -> Vec<varspec::PointSet> {
-    let s = samplers::build(name, n, Some(2), &[]).unwrap();
+    let s = registry::build(name, n, Some(2), &[]).unwrap();
     (0..sets as u64)
         .map(|r| s.sample(&mut set_rng(5, r)).unwrap())
         .collect()

@@ -4,8 +4,8 @@
 //! tests/data/README.md).
 
 use varspec::integrands;
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
 use varspec::variance::{VarianceError, fourier, spatial};
 
 /// z for a two-sided per-check rate of 6e-5: ~40 checks keep the
@@ -47,7 +47,7 @@ fn reference_file_is_present_and_complete() {
 fn fourier_predictions_match_the_exact_expected_variances() {
     for (spec, sampler, n, exact) in rows() {
         let f = integrands::parse(&spec).unwrap();
-        let s = samplers::build(&sampler, n, Some(2), &[]).unwrap();
+        let s = registry::build(&sampler, n, Some(2), &[]).unwrap();
         let realization =
             |r: usize| -> Result<_, VarianceError> { Ok(s.sample(&mut set_rng(77, r as u64))?) };
         let e = fourier(f.as_ref(), 63, 1e-10, 400, realization).unwrap();
@@ -66,7 +66,7 @@ fn fourier_predictions_match_the_exact_expected_variances() {
 fn spatial_predictions_match_the_exact_expected_variances() {
     for (spec, sampler, n, exact) in rows().into_iter().filter(|r| r.2 <= 256) {
         let f = integrands::parse(&spec).unwrap();
-        let s = samplers::build(&sampler, n, Some(2), &[]).unwrap();
+        let s = registry::build(&sampler, n, Some(2), &[]).unwrap();
         let realization =
             |r: usize| -> Result<_, VarianceError> { Ok(s.sample(&mut set_rng(78, r as u64))?) };
         let e = spatial(f.as_ref(), 400, realization).unwrap();

@@ -6,6 +6,7 @@ use proptest::prelude::*;
 use std::collections::HashSet;
 use varspec::PointSet;
 use varspec::points::toroidal_distance_sq;
+use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::samplers::{self, packing_radius};
 
@@ -14,7 +15,7 @@ fn draw(name: &str, n: usize, dim: usize, params: &[(&str, &str)], seed: u64) ->
         .iter()
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect();
-    let sampler = samplers::build(name, n, Some(dim), &params).unwrap();
+    let sampler = registry::build(name, n, Some(dim), &params).unwrap();
     let set = sampler.sample(&mut set_rng(seed, 0)).unwrap();
     assert_eq!((set.len(), set.dim()), (n, dim), "{name}: wrong shape");
     set
@@ -135,7 +136,7 @@ proptest! {
         prop_assert!(one_per_cell(&set, &[0, 1], &[m, m]));
         prop_assert!(latin(&set, 2) && latin(&set, 3));
         // The shorthand name:key=value gives the same sets.
-        let shorthand = varspec::samplers::build("padded:xy=jitter,uv=nrooks", n, Some(4), &[])
+        let shorthand = varspec::registry::build("padded:xy=jitter,uv=nrooks", n, Some(4), &[])
             .unwrap()
             .sample(&mut varspec::rng::set_rng(seed, 0))
             .unwrap();
@@ -178,9 +179,9 @@ proptest! {
 fn every_registered_sampler_stays_on_the_torus() {
     // PointSet::new validates [0,1) and finiteness; this drives every sampler
     // through it at an awkward N and the extreme PREV_ONE rounding.
-    for info in samplers::SAMPLERS {
+    for info in registry::SAMPLERS {
         let d = info.dims.default;
-        let (sampler, n) = samplers::build_nearest(info.name, 97, Some(d), &[]).unwrap();
+        let (sampler, n) = registry::build_nearest(info.name, 97, Some(d), &[]).unwrap();
         for seed in 0..20 {
             let set = sampler.sample(&mut set_rng(seed, 3)).unwrap();
             // A random-count sampler's N is its expected count.
@@ -204,7 +205,7 @@ fn poisson_disk_reports_jamming_instead_of_looping() {
         ("radius".to_string(), "0.95".to_string()),
         ("max-trials".to_string(), "100000".to_string()),
     ];
-    let sampler = samplers::build("poisson-disk", 500, Some(2), &params).unwrap();
+    let sampler = registry::build("poisson-disk", 500, Some(2), &params).unwrap();
     let err = sampler.sample(&mut set_rng(1, 0)).unwrap_err();
     let text = err.to_string();
     assert!(
@@ -262,7 +263,7 @@ fn public_constructors_refuse_what_they_cannot_do() {
     assert!(PoissonDisk::new(100, 2, 0.5, 10).is_ok());
     // Fewer than 2^32 coordinates, so point indices fit a u32.
     assert!(matches!(
-        varspec::samplers::build("nrooks", 1 << 32, Some(1), &[]),
+        varspec::registry::build("nrooks", 1 << 32, Some(1), &[]),
         Err(SamplerError::TooLarge { .. })
     ));
 }
@@ -277,7 +278,7 @@ fn public_constructors_refuse_what_they_cannot_do() {
 fn owen_scramble_has_the_pair_law_of_nested_uniform_scrambling() {
     let moments = |scramble: &str| {
         let params = vec![("scramble".to_string(), scramble.to_string())];
-        let s = samplers::build("sobol", 2, Some(1), &params).unwrap();
+        let s = registry::build("sobol", 2, Some(1), &params).unwrap();
         let r = 400_000u64;
         let (mut m1, mut m2) = (0.0, 0.0);
         for i in 0..r {

@@ -1,6 +1,7 @@
 //! The scene renderer: pixel integrands against closed forms, the light
 //! field's shear, determinism, and scene files refused with clear errors.
 
+use varspec::registry;
 use varspec::scene::Scene;
 use varspec::scene::analysis::{PixelKind, analyse_pixel};
 
@@ -120,7 +121,6 @@ fn edge_pixel(depth: f64, focus: f64, aperture: f64, edge: f64, px: usize) -> f6
 
 #[test]
 fn a_defocused_edge_matches_its_closed_form_for_every_sampler_and_shear() {
-    use varspec::samplers;
     use varspec::scene::analysis::SampleShear;
     use varspec::scene::render::render_variance;
     // Behind the focus (c < 0) and in front of it (c > 0); the edge in
@@ -134,7 +134,7 @@ fn a_defocused_edge_matches_its_closed_form_for_every_sampler_and_shear() {
         let kappa = analyse_pixel(&scene, 4, 4).kappa;
         assert!(kappa.abs() > 0.3, "the case must be defocused: κ = {kappa}");
         for name in ["random", "umj", "padded:xy=jitter,uv=random", "sobol"] {
-            let sampler = samplers::build(name, 64, Some(4), &[]).unwrap();
+            let sampler = registry::build(name, 64, Some(4), &[]).unwrap();
             for shear in [
                 SampleShear::NONE,
                 SampleShear::Position([0.7, -0.3]),
@@ -177,10 +177,9 @@ fn a_defocused_edge_matches_its_closed_form_for_every_sampler_and_shear() {
 
 #[test]
 fn the_warp_that_follows_the_light_field_cuts_the_variance_of_a_defocused_edge() {
-    use varspec::samplers;
     use varspec::scene::analysis::SampleShear;
     use varspec::scene::render::render_variance;
-    let sampler = samplers::build("umj", 64, Some(4), &[]).unwrap();
+    let sampler = registry::build("umj", 64, Some(4), &[]).unwrap();
     let renders = 64;
     for (depth, focus, aperture, edge) in [(6.0, 3.0, 0.3, 0.05), (2.0, 3.0, 0.2, -0.02)] {
         let scene = edge_scene(depth, focus, aperture, edge);
@@ -220,7 +219,6 @@ fn the_warp_that_follows_the_light_field_cuts_the_variance_of_a_defocused_edge()
 
 #[test]
 fn a_disk_light_sampled_on_its_area_or_its_bounding_square_gives_one_image() {
-    use varspec::samplers;
     use varspec::scene::analysis::SampleShear;
     use varspec::scene::render::render_variance;
     let disk = varspec::scene::BUILTIN_SCENES[2]
@@ -231,7 +229,7 @@ fn a_disk_light_sampled_on_its_area_or_its_bounding_square_gives_one_image() {
         "\"radiance\": 15.0, \"sampling\": \"bounding_square\"",
     );
     assert_ne!(disk, square);
-    let sampler = samplers::build("random", 64, Some(4), &[]).unwrap();
+    let sampler = registry::build("random", 64, Some(4), &[]).unwrap();
     let renders = 48;
     let maps = |text: &str| {
         let scene = Scene::from_text(text, "disk").unwrap();

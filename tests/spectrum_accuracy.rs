@@ -3,13 +3,13 @@
 
 use rustfft::num_complex::Complex64;
 use varspec::PointSet;
+use varspec::registry;
 use varspec::rng::{set_rng, uniform};
-use varspec::samplers;
 use varspec::spectrum::dft::{evaluate_series, sample_spectrum};
 use varspec::spectrum::{FrequencyBox, Method, NufftPlan, Sign, expected_power};
 
 fn draw(name: &str, n: usize, d: usize, seed: u64) -> PointSet {
-    samplers::build(name, n, Some(d), &[])
+    registry::build(name, n, Some(d), &[])
         .unwrap()
         .sample(&mut set_rng(seed, 0))
         .unwrap()
@@ -169,7 +169,7 @@ fn large_frequency_phases_are_exact_to_1e_12() {
 
 /// Mean and standard error of N·P_S(k) over `sets` realizations, per k.
 fn mean_and_se(name: &str, n: usize, b: FrequencyBox, sets: u64) -> (Vec<f64>, Vec<f64>) {
-    let sampler = samplers::build(name, n, Some(b.dim), &[]).unwrap();
+    let sampler = registry::build(name, n, Some(b.dim), &[]).unwrap();
     let plan = NufftPlan::new(b, 1e-10).unwrap();
     let mut scratch = plan.make_scratch();
     let mut s = vec![zero(); b.len()];

@@ -7,8 +7,8 @@
 
 use varspec::PointSet;
 use varspec::optimize::AdamOptions;
+use varspec::registry;
 use varspec::rng::{set_rng, uniform};
-use varspec::samplers;
 use varspec::square::design::{
     SquareTerm, closest_pair_ratio, default_options, design, parse_target,
 };
@@ -22,7 +22,7 @@ use varspec::square::{Family, family_mse};
 const Z: f64 = 3.89;
 
 fn sets(name: &str, n: usize, count: u64, seed: u64) -> Vec<PointSet> {
-    let s = samplers::build(name, n, Some(2), &[]).unwrap();
+    let s = registry::build(name, n, Some(2), &[]).unwrap();
     (0..count)
         .map(|r| s.sample(&mut set_rng(seed, r)).unwrap())
         .collect()

@@ -201,7 +201,7 @@ fn f32_tables_keep_every_point_in_its_stratum() {
     // f32 moves them onto the edge, into the next stratum.
     let m = 16usize;
     let below_edge: Vec<f64> = (1..=m).map(|k| k as f64 / m as f64 - 1e-12).collect();
-    let sampler = varspec::samplers::build("jitter", m * m, Some(2), &[]).unwrap();
+    let sampler = varspec::registry::build("jitter", m * m, Some(2), &[]).unwrap();
     let jittered = sampler.sample(&mut varspec::rng::set_rng(1, 0)).unwrap();
     let mut checked = 0;
     for x in below_edge.iter().chain(jittered.coords()) {

@@ -2,7 +2,9 @@
 //! to 1/2 over many realizations (each point is uniform on the torus, so the
 //! shift-free estimator of a linear integrand is unbiased).
 
-use varspec::samplers::{self, SAMPLERS};
+use varspec::registry;
+use varspec::registry::SAMPLERS;
+use varspec::samplers;
 
 /// Two-sided z for a per-check false-alarm rate of 1e-6: with ~50 checks the
 /// suite's family-wise rate stays below 1e-4 (the seeds are fixed, so a pass
@@ -29,7 +31,7 @@ fn coordinate_means_are_one_half_within_their_confidence_interval() {
         } else {
             (2000, vec![])
         };
-        let (sampler, n) = samplers::build_nearest(name, 64, Some(d), &params).unwrap();
+        let (sampler, n) = registry::build_nearest(name, 64, Some(d), &params).unwrap();
         let realizations = samplers::generate_sets(sampler.as_ref(), 2024, sets, &|| {}).unwrap();
         for j in 0..d {
             // Per-set mean of coordinate j, then their mean and standard error.

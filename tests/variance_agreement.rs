@@ -11,8 +11,9 @@
 //!   provides them).
 
 use varspec::integrands::{self, Integrand};
+use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, Sampler};
+use varspec::samplers::Sampler;
 use varspec::variance::{VarianceError, empirical, fourier, spatial};
 
 const SAMPLERS: [&str; 9] = [
@@ -81,7 +82,7 @@ fn run_for(n: usize) {
     for spec in INTEGRANDS {
         let f = integrands::parse(spec).unwrap();
         for name in SAMPLERS {
-            let sampler = samplers::build(name, n, Some(2), &[]).unwrap();
+            let sampler = registry::build(name, n, Some(2), &[]).unwrap();
             check(sampler.as_ref(), name, f.as_ref(), 12, 1000 + n as u64);
         }
     }

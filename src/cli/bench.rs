@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
+use varspec::registry;
 
 use clap::Subcommand;
 use rustfft::num_complex::Complex64;
@@ -10,7 +11,6 @@ use rustfft::num_complex::Complex64;
 use varspec::integrands;
 use varspec::io::write_atomic;
 use varspec::rng::set_rng;
-use varspec::samplers;
 use varspec::spectrum::dft::sample_spectrum;
 use varspec::spectrum::{FrequencyBox, Method, NufftPlan, Sign, SpectrumError, expected_power};
 use varspec::variance::{VarianceError, empirical, fourier, spatial_variance};
@@ -220,7 +220,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
 
     // N = 4096 random points on the 256² box (|k| < 128).
     let n = 4096;
-    let points = samplers::build("random", n, Some(2), &[])?.sample(&mut set_rng(1, 0))?;
+    let points = registry::build("random", n, Some(2), &[])?.sample(&mut set_rng(1, 0))?;
     let freqs = FrequencyBox::from_resolution(2, 256);
     let case = format!("random N={n}, 256^2 box");
     let (direct_s, exact) = time(2, || sample_spectrum(&points, &freqs));
@@ -274,7 +274,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
     }
 
     // Expected spectrum of 1000 jittered 1024-point sets on 128².
-    let jitter = samplers::build("jitter", 1024, Some(2), &[])?;
+    let jitter = registry::build("jitter", 1024, Some(2), &[])?;
     let freqs = FrequencyBox::from_resolution(2, 128);
     let (secs, _) = time(2, || {
         expected_power(
@@ -310,7 +310,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
         &[65_536, 1_048_576]
     };
     for &n in sizes {
-        let points = samplers::build("random", n, Some(2), &[])?.sample(&mut set_rng(3, 0))?;
+        let points = registry::build("random", n, Some(2), &[])?.sample(&mut set_rng(3, 0))?;
         let freqs = FrequencyBox::from_resolution(2, 512);
         for tol in [1e-6, 1e-12] {
             let plan = NufftPlan::new(freqs, tol)?;
@@ -367,7 +367,7 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
     let mut lines = vec!["case,method,seconds,variance,relative_error,threads".to_string()];
     let ns: &[usize] = if a.quick { &[1024] } else { &[1024, 4096] };
     for &n in ns {
-        let set = samplers::build("jitter", n, Some(2), &[])?.sample(&mut set_rng(11, 0))?;
+        let set = registry::build("jitter", n, Some(2), &[])?.sample(&mut set_rng(11, 0))?;
         for spec in ["disk:r=0.3", "halfplane:angle=17,offset=0.07"] {
             let f = integrands::parse(spec)?;
             let case = format!("jitter N={n}, {spec}");

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
+use varspec::registry;
 
 use anyhow::{Context, bail};
 
@@ -59,7 +60,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let bar = progress::bar(COMPARED.len() as u64, "sampling");
     let mut rows = Vec::new();
     for name in COMPARED {
-        let (sampler, n) = samplers::build_nearest(name, a.n, Some(2), &[])?;
+        let (sampler, n) = registry::build_nearest(name, a.n, Some(2), &[])?;
         let start = Instant::now();
         let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|| {})?;
         let seconds = start.elapsed().as_secs_f64();

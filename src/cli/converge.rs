@@ -2,6 +2,7 @@
 //! its confidence interval, beside the theoretical rate.
 
 use std::path::PathBuf;
+use varspec::registry;
 
 use anyhow::bail;
 use clap::ValueEnum;
@@ -111,7 +112,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut points = Vec::new();
     for &requested in &a.ns {
         let (sampler, n) =
-            samplers::build_nearest(&a.sampler, requested, Some(dim), &a.draw.params)?;
+            registry::build_nearest(&a.sampler, requested, Some(dim), &a.draw.params)?;
         let realization = |r: usize| -> Result<_, VarianceError> {
             Ok(sampler.sample(&mut set_rng(a.draw.seed, r as u64))?)
         };

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
+use varspec::registry;
 
 use anyhow::bail;
 use clap::Subcommand;
@@ -218,7 +219,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         }
         (Box::new(found.lattice), Some(found))
     } else {
-        (samplers::build(&init_name, a.n, Some(a.dim), &[])?, None)
+        (registry::build(&init_name, a.n, Some(a.dim), &[])?, None)
     };
     let bar = progress::bar((a.sets * iters) as u64, "optimizing");
     let results = design_sets(
@@ -250,7 +251,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         json!({"n": a.n, "loss": mean(&final_losses)}),
     );
     for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
-        if let Ok((s, n)) = samplers::build_nearest(name, a.n, Some(a.dim), &[]) {
+        if let Ok((s, n)) = registry::build_nearest(name, a.n, Some(a.dim), &[]) {
             let losses: Vec<f64> = (0..a.sets.max(8) as u64)
                 .into_par_iter()
                 .map(|r| {
@@ -382,7 +383,7 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
 
     let terms = parse_projections(&a.target, a.n)?;
     let init_name = a.init.clone().unwrap_or_else(|| "umj".into());
-    let init = samplers::build(&init_name, a.n, Some(4), &[])?;
+    let init = registry::build(&init_name, a.n, Some(4), &[])?;
     let options = AdamOptions {
         iters: a.iters.unwrap_or(1000),
         rel_tol: a.rel_tol.unwrap_or(1e-4),
@@ -467,7 +468,7 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
         options.iters = i;
     }
     let init_name = a.init.clone().unwrap_or_else(|| "jitter".into());
-    let (init, n) = samplers::build_nearest(&init_name, a.n, Some(2), &[])?;
+    let (init, n) = registry::build_nearest(&init_name, a.n, Some(2), &[])?;
     if n != a.n {
         bail!(
             "--init {init_name} cannot start from N = {} (nearest: {n}); pick another --init or N",
@@ -517,7 +518,7 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     let mut comparison = serde_json::Map::new();
     comparison.insert("optimized".into(), json!(score(&sets)));
     for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
-        if let Ok((s, n)) = samplers::build_nearest(name, a.n, Some(2), &[]) {
+        if let Ok((s, n)) = registry::build_nearest(name, a.n, Some(2), &[]) {
             let classic: Vec<_> = (0..a.sets.max(8) as u64)
                 .map(|r| s.sample(&mut set_rng(a.seed ^ 0x5eed, r)))
                 .collect::<Result<_, _>>()?;
@@ -606,7 +607,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             a.range
         );
     }
-    let sampler = samplers::build(&a.sampler, a.n, Some(4), &[])?;
+    let sampler = registry::build(&a.sampler, a.n, Some(4), &[])?;
     let start = Instant::now();
     let spectral = spectral_start(f.as_ref(), 64, a.range);
     let mut starts = spectral.candidates();

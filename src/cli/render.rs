@@ -3,13 +3,13 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
+use varspec::registry;
 
 use anyhow::{Context, bail};
 
 use super::{args, progress};
 use varspec::io::write_atomic;
 use varspec::report::plot::{HeatMap, heatmap_png};
-use varspec::samplers;
 use varspec::scene::analysis::{PixelKind, SampleShear};
 use varspec::scene::image::GreyImage;
 use varspec::scene::render::{
@@ -123,7 +123,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.shear_png.as_deref(),
     ])?;
     let scene = Scene::load(&a.scene)?;
-    let sampler = samplers::build(&a.sampler, a.spp, Some(4), &a.params).with_context(|| {
+    let sampler = registry::build(&a.sampler, a.spp, Some(4), &a.params).with_context(|| {
         format!(
             "--sampler {}: rendering needs a 4D sampler (x, y on the pixel, u, v on the lens or light)",
             a.sampler

@@ -2,6 +2,7 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use varspec::registry;
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
@@ -10,7 +11,8 @@ use super::{args, progress};
 use varspec::io::npy::write_point_sets_npy;
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
 use varspec::points::PointSet;
-use varspec::samplers::{self, SAMPLERS};
+use varspec::registry::SAMPLERS;
+use varspec::samplers;
 
 /// Point-set file formats.
 #[derive(Clone, Copy, ValueEnum)]
@@ -88,7 +90,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.sets == 0 {
         bail!("--sets must be at least 1");
     }
-    let sampler = samplers::build(&name, n, a.dim, &a.params)?;
+    let sampler = registry::build(&name, n, a.dim, &a.params)?;
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
     let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|| bar.inc(1))?;
     bar.finish_and_clear();

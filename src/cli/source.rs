@@ -2,6 +2,7 @@
 //! realizations of a sampler; optionally projected onto chosen dimensions.
 
 use std::path::PathBuf;
+use varspec::registry;
 
 use anyhow::{Context, bail};
 
@@ -9,7 +10,7 @@ use super::args;
 use varspec::PointSet;
 use varspec::io::read_point_sets;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, Sampler};
+use varspec::samplers::Sampler;
 
 #[derive(clap::Args)]
 pub struct SourceArgs {
@@ -108,7 +109,7 @@ impl SourceArgs {
                     bail!("--sets must be at least 1");
                 }
                 let n = self.n.context("--sampler needs -n")?;
-                let sampler = samplers::build(name, n, self.dim, &self.draw.params)?;
+                let sampler = registry::build(name, n, self.dim, &self.draw.params)?;
                 Source::Sampler {
                     sampler,
                     seed: self.draw.seed,

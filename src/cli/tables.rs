@@ -1,6 +1,7 @@
 //! `varspec tables`: pattern tables for renderers, with metadata.
 
 use std::path::PathBuf;
+use varspec::registry;
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
@@ -72,7 +73,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             if a.draw.sets() == 0 {
                 bail!("--sets must be at least 1");
             }
-            let s = samplers::build(name, n, a.dim, &a.draw.params)?;
+            let s = registry::build(name, n, a.dim, &a.draw.params)?;
             let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =
                 samplers::generate_sets(s.as_ref(), a.draw.seed, a.draw.sets(), &|| bar.inc(1))?;
@@ -94,8 +95,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let optimized_for = match &a.sampler {
         None => "unknown".to_string(),
         Some(spec) => {
-            let (name, params) = samplers::split_spec(spec, &a.draw.params)?;
-            if samplers::find(name)?.name == "blue-noise" {
+            let (name, params) = registry::split_spec(spec, &a.draw.params)?;
+            if registry::find(name)?.name == "blue-noise" {
                 params
                     .iter()
                     .rev()

@@ -1,5 +1,6 @@
 //! Running an experiment's items, whole or by shard, and merging shards.
 
+use crate::registry;
 use serde::{Deserialize, Serialize};
 
 use super::spec::{Experiment, ExperimentError};
@@ -114,7 +115,7 @@ pub fn run_items(
             integrand: integrand.to_string(),
             reason,
         };
-        let (s, n) = samplers::build_nearest(sampler, requested, Some(dim), &[])
+        let (s, n) = registry::build_nearest(sampler, requested, Some(dim), &[])
             .map_err(|err| fail("-", err.to_string()))?;
         // Realizations drawn once per item and shared by every integrand.
         let sets = samplers::generate_sets(s.as_ref(), e.seed, e.sets, &|| {})

@@ -57,7 +57,7 @@ impl Layers {
     fn cross_covariance(&self) -> f64 {
         let dc = self.layers[1].shear() - self.layers[0].shear();
         let g = self.layers[0].shape();
-        let mut total = crate::variance::sum::NeumaierSum::default();
+        let mut total = crate::sum::NeumaierSum::default();
         for kx in -CROSS_HALF..=CROSS_HALF {
             for ky in -CROSS_HALF..=CROSS_HALF {
                 if kx == 0 && ky == 0 {

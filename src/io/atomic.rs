@@ -12,20 +12,29 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::Error;
+/// An output that could not be written, naming the file.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot write {path}: {cause}")]
+pub struct WriteError {
+    /// The file that was being written.
+    pub path: std::path::PathBuf,
+    /// The underlying I/O error (in the message, so not repeated as a
+    /// source when error chains are printed).
+    pub cause: io::Error,
+}
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Writes `path` atomically with the bytes `write` produces.
 ///
 /// # Errors
-/// [`Error::Write`] naming `path` if the folder is missing or not writable,
+/// [`WriteError`] naming `path` if the folder is missing or not writable,
 /// `write` fails, or the rename fails; the temporary file is removed.
-pub fn write_atomic<F>(path: &Path, write: F) -> Result<(), Error>
+pub fn write_atomic<F>(path: &Path, write: F) -> Result<(), WriteError>
 where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
-    let fail = |cause| Error::Write {
+    let fail = |cause| WriteError {
         path: path.to_path_buf(),
         cause,
     };
@@ -60,13 +69,13 @@ where
 /// and it is not a folder itself.
 ///
 /// # Errors
-/// [`Error::Write`] naming `path` and what is wrong.
-pub fn check_output(path: &Path) -> Result<(), Error> {
-    let fail = |message: String| Error::Write {
+/// [`WriteError`] naming `path` and what is wrong.
+pub fn check_output(path: &Path) -> Result<(), WriteError> {
+    let fail = |message: String| WriteError {
         path: path.to_path_buf(),
         cause: io::Error::other(message),
     };
-    let target = resolve_links(path).map_err(|cause| Error::Write {
+    let target = resolve_links(path).map_err(|cause| WriteError {
         path: path.to_path_buf(),
         cause,
     })?;

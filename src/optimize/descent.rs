@@ -174,7 +174,7 @@ impl PointOptimizer {
 
     fn loss_of(&self, s: &[Complex64], n: usize) -> f64 {
         let n2 = (n * n) as f64;
-        crate::variance::sum::sum(s.iter().zip(&self.weights).map(|(v, w)| w * v.norm_sqr())) / n2
+        crate::sum::sum(s.iter().zip(&self.weights).map(|(v, w)| w * v.norm_sqr())) / n2
     }
 
     /// Loss and gradient (point-major, d per point) at `points`.

@@ -26,7 +26,7 @@ use super::OptimizeError;
 use crate::integrands::Integrand;
 use crate::points::PointSet;
 use crate::rng::{SetRng, uniform};
-use crate::variance::sum::NeumaierSum;
+use crate::sum::NeumaierSum;
 
 /// Evaluations of c_f the exhaustive exact ranking may spend (σ(N)·N).
 pub const EXACT_BUDGET: u64 = 1 << 26;

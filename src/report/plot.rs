@@ -11,6 +11,7 @@ use plotters::style::{FontStyle, register_font};
 
 use super::png::save_png;
 use crate::Error;
+use crate::io::WriteError;
 use crate::spectrum::Spectrum;
 
 static FONT: Once = Once::new();
@@ -75,9 +76,11 @@ pub fn line_plot_png(plot: &LinePlot, path: &Path) -> Result<(), Error> {
     let (w, h) = (800u32, 560u32);
     let mut buf = vec![255u8; (w * h * 3) as usize];
     let drawn = draw_lines(plot, &mut buf, (w, h));
-    drawn.map_err(|cause| Error::Write {
-        path: path.to_path_buf(),
-        cause,
+    drawn.map_err(|cause| {
+        Error::Write(WriteError {
+            path: path.to_path_buf(),
+            cause,
+        })
     })?;
     let img = image::RgbImage::from_raw(w, h, buf).expect("buffer matches size");
     save_png(&img, path)
@@ -239,10 +242,10 @@ pub struct HeatMap<'a> {
 /// same way.
 pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(), Error> {
     if spectrum.freqs.dim != 2 {
-        return Err(Error::Write {
+        return Err(Error::Write(WriteError {
             path: path.to_path_buf(),
             cause: std::io::Error::other("a spectrum picture needs a 2D spectrum (use --dims)"),
-        });
+        }));
     }
     let zero = spectrum.freqs.zero_index();
     let logs: Vec<f64> = spectrum
@@ -292,9 +295,11 @@ pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(),
 /// [`Error::Write`] naming `path` (also for an empty or ragged grid and for
 /// drawing failures).
 pub fn heatmap_png(map: &HeatMap, path: &Path) -> Result<(), Error> {
-    let fail = |cause| Error::Write {
-        path: path.to_path_buf(),
-        cause,
+    let fail = |cause| {
+        Error::Write(WriteError {
+            path: path.to_path_buf(),
+            cause,
+        })
     };
     if map.width == 0 || map.values.is_empty() || map.values.len() % map.width != 0 {
         return Err(fail(std::io::Error::other(format!(

@@ -74,4 +74,5 @@ pub fn save_png(img: &RgbImage, path: &Path) -> Result<(), Error> {
             )
             .map_err(std::io::Error::other)
     })
+    .map_err(Error::from)
 }

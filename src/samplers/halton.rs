@@ -8,7 +8,7 @@
 //! leading zeros of i, so each coordinate is uniform on [0,1) to double
 //! precision while the stratification of the Halton sequence is kept.
 
-use super::registry::Config;
+use super::config::Config;
 use super::{Sampler, SamplerError};
 use crate::points::PointSet;
 use crate::rng::{PREV_ONE, SetRng, permutation};
@@ -50,7 +50,7 @@ impl Halton {
     }
 }
 
-pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     Ok(Box::new(Halton::new(c.n, c.dim)?))
 }
 

@@ -11,7 +11,7 @@
 //! random count adds E[(N/λ − 1)²]·I² to the variance (docs/mathematics.md
 //! §2, "A random number of points").
 
-use super::registry::{Config, integer_root};
+use super::config::{Config, integer_root};
 use super::{Sampler, SamplerError};
 use crate::points::PointSet;
 use crate::rng::{SetRng, uniform};
@@ -38,7 +38,7 @@ impl IsotropicJitter {
     }
 }
 
-pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let m = integer_root(c.n, 2);
     if m * m != c.n {
         return Err(c.bad_count(

@@ -9,7 +9,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::registry::{Config, integer_root, pow_saturating};
+use super::config::{Config, integer_root, pow_saturating};
 use super::{Sampler, SamplerError};
 use crate::points::{PointSet, stratum_coord};
 use crate::rng::{SetRng, uniform};
@@ -58,15 +58,15 @@ fn from_config(c: &Config, offset: StratumOffset) -> Result<Box<dyn Sampler>, Sa
     Ok(Box::new(Jitter::new(m, c.dim, offset)))
 }
 
-pub(super) fn regular_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn regular_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     from_config(c, StratumOffset::Centre)
 }
 
-pub(super) fn jitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn jitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     from_config(c, StratumOffset::Independent)
 }
 
-pub(super) fn uniform_jitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn uniform_jitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     from_config(c, StratumOffset::Shared)
 }
 

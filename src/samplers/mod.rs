@@ -1,22 +1,22 @@
-//! Point-set samplers: one file per family behind the [`Sampler`] trait, and
-//! the registry ([`SAMPLERS`]) that names them for the command line.
+//! Point-set samplers: one file per family behind the [`Sampler`] trait.
+//! The registry that names them for the command line is
+//! [`crate::registry`].
 //!
 //! A sampler is an immutable configuration (N, d, parameters); randomness is
 //! handed in as a [`SetRng`] (docs/architecture.md, "Conventions"). [`generate_sets`] draws many
 //! realizations in parallel, realization r from stream (seed, r), so the
 //! output is identical for any number of threads.
 
-mod halton;
-mod isotropic_jitter;
-mod jitter;
-mod multijitter;
-mod nrooks;
-mod optimized;
-mod padded;
-mod poisson_disk;
-mod random;
-mod registry;
-mod sobol;
+pub mod config;
+pub(crate) mod halton;
+pub(crate) mod isotropic_jitter;
+pub(crate) mod jitter;
+pub(crate) mod multijitter;
+pub(crate) mod nrooks;
+pub(crate) mod padded;
+pub(crate) mod poisson_disk;
+pub(crate) mod random;
+pub(crate) mod sobol;
 mod sobol_table;
 
 pub use halton::Halton;
@@ -27,9 +27,6 @@ pub use nrooks::NRooks;
 pub use padded::Padded;
 pub use poisson_disk::{PoissonDisk, packing_radius};
 pub use random::Random;
-pub use registry::{
-    DimRange, ParamInfo, SAMPLERS, SamplerInfo, build, build_nearest, find, split_spec,
-};
 pub use sobol::Sobol;
 
 use rayon::prelude::*;

@@ -13,7 +13,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::registry::Config;
+use super::config::Config;
 use super::{Sampler, SamplerError};
 use crate::points::{PointSet, stratum_coord};
 use crate::rng::{SetRng, permutation, uniform};
@@ -39,7 +39,7 @@ impl MultiJitter {
 
     /// The grid (m, n) used for N points: m = `columns` if given, else the
     /// largest divisor of N not above √N.
-    pub(super) fn grid(c: &Config) -> Result<(usize, usize), SamplerError> {
+    pub(crate) fn grid(c: &Config) -> Result<(usize, usize), SamplerError> {
         let n = c.n;
         let m = match c.param("m") {
             "auto" => (1..=n)
@@ -57,7 +57,7 @@ impl MultiJitter {
 
     /// Writes the set's (x, y) pairs into `out` (length 2N), point (i, j)
     /// at index j·m + i.
-    pub(super) fn fill(&self, rng: &mut SetRng, out: &mut [f64]) {
+    pub(crate) fn fill(&self, rng: &mut SetRng, out: &mut [f64]) {
         let (m, n) = (self.columns, self.rows);
         let total = m * n;
         let shared_sigma = self.correlated.then(|| permutation(rng, n));
@@ -91,12 +91,12 @@ impl MultiJitter {
     }
 }
 
-pub(super) fn multijitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn multijitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let (m, n) = MultiJitter::grid(c)?;
     Ok(Box::new(MultiJitter::new(m, n, false)))
 }
 
-pub(super) fn cmj_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn cmj_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let (m, n) = MultiJitter::grid(c)?;
     Ok(Box::new(MultiJitter::new(m, n, true)))
 }

@@ -3,7 +3,7 @@
 //! in each interval [i/N, (i+1)/N), the intervals of different axes paired by
 //! independent random permutations.
 
-use super::registry::Config;
+use super::config::Config;
 use super::{Sampler, SamplerError};
 use crate::points::{PointSet, stratum_coord};
 use crate::rng::{SetRng, permutation, uniform};
@@ -22,7 +22,7 @@ impl NRooks {
     }
 }
 
-pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     Ok(Box::new(NRooks::new(c.n, c.dim)))
 }
 

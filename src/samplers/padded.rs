@@ -6,8 +6,8 @@
 //! Jarosz 2017, "Convergence analysis for anisotropic Monte Carlo sampling
 //! spectra", ACM TOG 36(4)) is the case of two multi-jittered halves.
 
+use super::config::Config;
 use super::multijitter::MultiJitter;
-use super::registry::{Config, build};
 use super::{Sampler, SamplerError};
 use crate::points::PointSet;
 use crate::rng::{SetRng, permutation};
@@ -44,7 +44,7 @@ impl Padded {
     }
 }
 
-pub(super) fn umj_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn umj_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let correlated = match c.param("pairs") {
         "mj" | "multijitter" => false,
         "cmj" => true,
@@ -55,13 +55,13 @@ pub(super) fn umj_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerErr
     Ok(Box::new(Padded::new(half(), half())?))
 }
 
-pub(super) fn padded_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn padded_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let half = |key: &'static str| {
         let name = c.param(key);
         if matches!(name, "padded" | "umj") {
             return Err(c.bad_param(key, "a 2D sampler (see varspec sample --list)"));
         }
-        build(name, c.n, Some(2), &[])
+        c.build_other(name, c.n, Some(2), &[])
     };
     Ok(Box::new(Padded::new(half("xy")?, half("uv")?)?))
 }

@@ -11,7 +11,7 @@
 //! Dart throwing jams (no room for another point) at packing fraction 0.547
 //! in 2D (Feder 1980), i.e. ρ ≈ 0.78; 3D and 4D jam near ρ ≈ 0.80.
 
-use super::registry::{Config, pow_saturating};
+use super::config::{Config, pow_saturating};
 use super::{Sampler, SamplerError};
 use crate::points::{PointSet, toroidal_distance_sq};
 use crate::rng::{SetRng, uniform};
@@ -113,7 +113,7 @@ impl PoissonDisk {
     }
 }
 
-pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let rho: f64 = c
         .param("radius")
         .parse()

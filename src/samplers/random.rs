@@ -3,7 +3,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::registry::Config;
+use super::config::Config;
 use super::{Sampler, SamplerError};
 use crate::points::PointSet;
 use crate::rng::{SetRng, uniform};
@@ -23,7 +23,7 @@ impl Random {
     }
 }
 
-pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     Ok(Box::new(Random::new(c.n, c.dim)))
 }
 

@@ -16,7 +16,7 @@
 //! (0, m, 2)-net. Below the 32 scrambled bits, 21 uniform bits complete the
 //! f64 mantissa so every coordinate is uniform on [0,1).
 
-use super::registry::Config;
+use super::config::Config;
 use super::sobol_table::JOE_KUO;
 use super::{Sampler, SamplerError};
 use crate::points::PointSet;
@@ -126,7 +126,7 @@ pub fn owen_scramble(x: u32, seed: u64) -> u32 {
     out
 }
 
-pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     if c.n as u64 > 1 << 32 {
         return Err(c.bad_count("N <= 2^32", Some(1 << 32), None));
     }

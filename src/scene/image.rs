@@ -26,7 +26,7 @@ impl GreyImage {
     /// # Errors
     /// [`Error::Write`] naming `path`.
     pub fn write_pfm(&self, path: &Path) -> Result<(), Error> {
-        write_atomic(path, |w| self.pfm(w))
+        write_atomic(path, |w| self.pfm(w)).map_err(Error::from)
     }
 
     fn pfm(&self, w: &mut dyn Write) -> io::Result<()> {

@@ -12,7 +12,7 @@ use super::analysis::{PixelAnalysis, PixelKind, SampleShear, analyse_pixel};
 use super::image::GreyImage;
 use crate::rng::set_rng;
 use crate::samplers::{Sampler, SamplerError};
-use crate::variance::sum::NeumaierSum;
+use crate::sum::NeumaierSum;
 
 /// How each pixel's sample set is sheared.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -286,7 +286,7 @@ pub fn mse_against(
         let s2 = variance.map_or(0.0, |v| v[i]);
         (r - 1.0) / r * s2 + (m - x) * (m - x)
     });
-    crate::variance::sum::sum(per_pixel) / mean.len() as f64
+    crate::sum::sum(per_pixel) / mean.len() as f64
 }
 
 /// Mean (compensated), median and 95th percentile (nearest rank) of
@@ -309,7 +309,7 @@ impl PixelStatistics {
         let rank =
             |q: f64| sorted[((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1];
         PixelStatistics {
-            mean: crate::variance::sum::sum(values.iter().copied()) / values.len() as f64,
+            mean: crate::sum::sum(values.iter().copied()) / values.len() as f64,
             median: rank(0.5),
             p95: rank(0.95),
         }

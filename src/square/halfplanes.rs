@@ -103,7 +103,7 @@ pub fn directional_loss(
             .map(|(i, p)| (projection.project(p), i)),
     );
     order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    let mut sum = crate::variance::sum::NeumaierSum::default();
+    let mut sum = crate::sum::NeumaierSum::default();
     let mut grad = gradient;
     let normal = projection.normal();
     for (k, &(a, i)) in order.iter().enumerate() {
@@ -137,7 +137,7 @@ pub fn halfplane_mse(set: &PointSet, q: usize) -> f64 {
 pub fn pair_form(set: &PointSet, projection: &Projection) -> f64 {
     let a: Vec<f64> = set.points().map(|p| projection.project(p)).collect();
     let n = a.len() as f64;
-    let mut pairs = crate::variance::sum::NeumaierSum::default();
+    let mut pairs = crate::sum::NeumaierSum::default();
     for &ai in &a {
         for &aj in &a {
             pairs.add(projection.cdf(ai.min(aj)).0);

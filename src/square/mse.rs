@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::family::Family;
 use crate::points::PointSet;
-use crate::variance::sum::NeumaierSum;
+use crate::sum::NeumaierSum;
 
 /// A family MSE with its uncertainty.
 #[derive(Debug, Clone, PartialEq)]
@@ -56,10 +56,9 @@ pub fn family_mse(sets: &[PointSet], family: &Family, members: usize, seed: u64)
         .iter()
         .map(|e| e.iter().sum::<f64>() / e.len().max(1) as f64)
         .collect();
-    let mean = crate::variance::sum::sum(per_member.iter().copied()) / members as f64;
+    let mean = crate::sum::sum(per_member.iter().copied()) / members as f64;
     let spread = if members > 1 {
-        crate::variance::sum::sum(per_member.iter().map(|v| (v - mean) * (v - mean)))
-            / (members - 1) as f64
+        crate::sum::sum(per_member.iter().map(|v| (v - mean) * (v - mean))) / (members - 1) as f64
     } else {
         0.0
     };

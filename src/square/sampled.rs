@@ -14,7 +14,7 @@ use rayon::prelude::*;
 
 use super::family::Family;
 use crate::points::PointSet;
-use crate::variance::sum::NeumaierSum;
+use crate::sum::NeumaierSum;
 
 /// Members per parallel task: fixed, so sums are thread-count independent.
 const CHUNK: usize = 16;

@@ -7,6 +7,7 @@
 
 pub mod html;
 
+use crate::registry;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -20,7 +21,7 @@ use crate::points::PointSet;
 use crate::report::plot::{LinePlot, Series, line_plot_png, spectrum_png};
 use crate::report::png::{render_points, save_png};
 use crate::rng::set_rng;
-use crate::samplers::{self, Sampler};
+use crate::samplers::Sampler;
 use crate::spectrum::radial::radial_profile;
 use crate::spectrum::{FrequencyBox, Method, expected_power};
 use crate::square::design::{closest_pair_ratio, default_options, design, parse_target};
@@ -355,7 +356,7 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
     let freqs = FrequencyBox::from_resolution(2, 64);
     for name in names {
         let (sampler, n) =
-            samplers::build_nearest(name, o.n, Some(2), &[]).map_err(at("building a sampler"))?;
+            registry::build_nearest(name, o.n, Some(2), &[]).map_err(at("building a sampler"))?;
         let start = Instant::now();
         let sets = draw(sampler.as_ref(), o.seed, o.sets)?;
         let seconds_per_set = start.elapsed().as_secs_f64() / o.sets as f64;
@@ -468,7 +469,7 @@ fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
     let n = 256;
     let target = "halfplanes+gaussians+16*blue";
     let terms = parse_target(target).map_err(at("square target"))?;
-    let jitter = samplers::build("jitter", n, Some(2), &[]).map_err(at("jitter"))?;
+    let jitter = registry::build("jitter", n, Some(2), &[]).map_err(at("jitter"))?;
     let count = 2;
     let start = Instant::now();
     let designed: Vec<PointSet> = draw(jitter.as_ref(), o.seed, count)?
@@ -507,7 +508,7 @@ fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
     };
     score(format!("designed ({target})"), &designed);
     for name in ["jitter", "cmj", "sobol"] {
-        let s = samplers::build(name, n, Some(2), &[]).map_err(at("a sampler"))?;
+        let s = registry::build(name, n, Some(2), &[]).map_err(at("a sampler"))?;
         score(name.into(), &draw(s.as_ref(), o.seed ^ 7, 16)?);
     }
     let best = rows
@@ -547,7 +548,7 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
         .light_field()
         .map(|l| l.layer_shears()[0][0])
         .ok_or_else(|| at("the pixel")("not a light field"))?;
-    let umj = samplers::build("umj", n, Some(4), &[]).map_err(at("umj"))?;
+    let umj = registry::build("umj", n, Some(4), &[]).map_err(at("umj"))?;
     let start = Instant::now();
     let spectral = spectral_start(f.as_ref(), 64, 2.0);
     let mut starts = spectral.candidates();
@@ -631,7 +632,7 @@ fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
     use crate::scene::render::{ShearPolicy, analyse, pixel_shears, render_variance};
     let (spp, renders) = (64, 4);
     let scene = Scene::load("dof").map_err(at("the scene"))?;
-    let umj = samplers::build("umj", spp, Some(4), &[]).map_err(at("umj"))?;
+    let umj = registry::build("umj", spp, Some(4), &[]).map_err(at("umj"))?;
     let analysis = analyse(&scene);
     let count = |k: PixelKind| analysis.iter().filter(|p| p.kind == k).count();
     let mut rows = Vec::new();
@@ -678,7 +679,7 @@ fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
         sorted.sort_by(f64::total_cmp);
         rows.push(SceneRow {
             method: method.into(),
-            mean_variance: crate::variance::sum::sum(sorted.iter().copied()) / sorted.len() as f64,
+            mean_variance: crate::sum::sum(sorted.iter().copied()) / sorted.len() as f64,
             median_variance: sorted[sorted.len() / 2],
             seconds,
         });
@@ -703,7 +704,7 @@ fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
 
 fn speed_section(o: &TourOptions) -> Result<SpeedSection, TourError> {
     let (n, sets, half) = (1024, 8, 64);
-    let jitter = samplers::build("jitter", n, Some(2), &[]).map_err(at("jitter"))?;
+    let jitter = registry::build("jitter", n, Some(2), &[]).map_err(at("jitter"))?;
     let drawn = draw(jitter.as_ref(), o.seed, sets)?;
     let freqs = FrequencyBox { dim: 2, half };
     let run = |method: Method| -> Result<(f64, Vec<f64>), TourError> {

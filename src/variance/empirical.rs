@@ -9,10 +9,10 @@
 use rayon::prelude::*;
 
 use super::VarianceError;
-use super::sum::{NeumaierSum, sum};
 use crate::integrands::Integrand;
 use crate::points::PointSet;
 use crate::rng::{set_rng, uniform};
+use crate::sum::{NeumaierSum, sum};
 
 /// Stream offset separating shift draws from sampler draws of the same seed.
 const SHIFT_STREAM: u64 = 0x5348_4946_5453_4545;

@@ -32,10 +32,10 @@
 use rayon::prelude::*;
 
 use super::VarianceError;
-use super::sum::NeumaierSum;
 use crate::integrands::Integrand;
 use crate::points::PointSet;
 use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power_with};
+use crate::sum::NeumaierSum;
 
 /// Shell deviation |N·P_S − 1| above which the spectrum is treated as a
 /// lattice's (see the module doc).
@@ -212,7 +212,7 @@ where
     let counts = counts.into_inner().expect("no panics while held");
     let i2 = f.integral() * f.integral();
     let count_bias = |c: usize| (c as f64 / intensity - 1.0).powi(2) * i2;
-    let count_term = super::sum::sum(counts.iter().map(|&c| count_bias(c))) / sets as f64;
+    let count_term = crate::sum::sum(counts.iter().map(|&c| count_bias(c))) / sets as f64;
     let tail_mass = (f.variance() - mass.value()).max(0.0);
     let (bias, spread, pf_max) = if shell.is_empty() {
         (1.0, 0.0, 0.0)

@@ -14,7 +14,6 @@ pub mod fourier;
 pub mod measure;
 pub mod radial;
 pub mod spatial;
-pub mod sum;
 
 pub use convergence::{SlopeFit, fit_slope, theoretical_rate};
 pub use empirical::{EmpiricalEstimate, empirical, empirical_shifting};

@@ -18,7 +18,7 @@
 //! the wrong rate.
 
 use super::fourier::FourierParts;
-use super::sum::NeumaierSum;
+use crate::sum::NeumaierSum;
 
 /// The radial prediction.
 #[derive(Debug, Clone, PartialEq)]

@@ -18,10 +18,10 @@
 use rayon::prelude::*;
 
 use super::VarianceError;
-use super::sum::NeumaierSum;
 use crate::integrands::Integrand;
 use crate::neighbours::CellGrid;
 use crate::points::PointSet;
+use crate::sum::NeumaierSum;
 
 /// Rows per parallel task (fixed: the reduction order must not depend on
 /// the thread count).
@@ -187,10 +187,10 @@ where
 /// Mean and standard error of the mean, two-pass.
 pub(crate) fn mean_and_stderr(values: &[f64]) -> (f64, f64) {
     let r = values.len() as f64;
-    let mean = super::sum::sum(values.iter().copied()) / r;
+    let mean = crate::sum::sum(values.iter().copied()) / r;
     if values.len() < 2 {
         return (mean, 0.0);
     }
-    let ss = super::sum::sum(values.iter().map(|v| (v - mean).powi(2)));
+    let ss = crate::sum::sum(values.iter().map(|v| (v - mean).powi(2)));
     (mean, (ss / (r - 1.0) / r).sqrt())
 }

@@ -40,7 +40,7 @@ use crate::rng::set_rng;
 use crate::samplers::Sampler;
 use crate::spectrum::pair::{EmpiricalPairs, PairSpectrum};
 use crate::spectrum::{FrequencyBox, Method, expected_power_with};
-use crate::variance::sum::NeumaierSum;
+use crate::sum::NeumaierSum;
 
 /// Terms summed per parallel task: fixed, so the sum's rounding is the
 /// same for any number of threads.
@@ -566,7 +566,6 @@ fn sample_variance(values: &[f64]) -> f64 {
     if values.len() < 2 {
         return 0.0;
     }
-    let mean = crate::variance::sum::sum(values.iter().copied()) / values.len() as f64;
-    crate::variance::sum::sum(values.iter().map(|v| (v - mean) * (v - mean)))
-        / (values.len() - 1) as f64
+    let mean = crate::sum::sum(values.iter().copied()) / values.len() as f64;
+    crate::sum::sum(values.iter().map(|v| (v - mean) * (v - mean))) / (values.len() - 1) as f64
 }

@@ -1,4 +1,5 @@
-//! Optimized point sets as a sampler: each realization starts from a
+//! Optimized point sets as a sampler (registered as `blue-noise` by
+//! [`crate::registry`]): each realization starts from a
 //! classic sampler's draw (from the realization's own stream) and descends
 //! toward a target. On the torus (the default) the target is a spectral
 //! loss of [`crate::optimize::descent`], by default the disk family, i.e.
@@ -8,11 +9,11 @@
 //! repulsion, starting from jitter. Deterministic for a seed like every
 //! sampler.
 
-use super::registry::{Config, build};
-use super::{Random, Sampler, SamplerError};
 use crate::optimize::{AdamOptions, DescentOptions, PointOptimizer, Target};
 use crate::points::PointSet;
 use crate::rng::SetRng;
+use crate::samplers::config::Config;
+use crate::samplers::{Random, Sampler, SamplerError};
 use crate::square::design::{SquareTerm, default_options, design, parse_target};
 
 /// The square's default target.
@@ -37,7 +38,7 @@ enum How {
     },
 }
 
-pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let iters: Option<usize> = match c.given("iters") {
         None => None,
         Some(text) => Some(
@@ -76,7 +77,7 @@ pub(super) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> 
                 options.iters = i;
             }
             How::Square {
-                start: build("jitter", c.n, Some(2), &[])?,
+                start: c.build_other("jitter", c.n, Some(2), &[])?,
                 terms,
                 options,
             }

@@ -1,34 +1,16 @@
 //! The sampler registry: names, aliases, supported dimensions, constraints on
 //! N and parameters of every sampler, in one table that both the command line
-//! (`varspec sample --list`) and [`build`] read.
+//! (`varspec sample --list`) and [`build`] read. It sits above both the
+//! samplers (src/samplers) and the optimizer (src/optimize), which registers
+//! its descent as the `blue-noise` sampler: neither depends on the registry.
 
-use super::{Sampler, SamplerError};
-use super::{
-    halton, isotropic_jitter, jitter, multijitter, nrooks, optimized, padded, poisson_disk, random,
-    sobol,
+use crate::optimized;
+use crate::samplers::config::Config;
+pub use crate::samplers::config::{DimRange, ParamInfo};
+use crate::samplers::{
+    Sampler, SamplerError, halton, isotropic_jitter, jitter, multijitter, nrooks, padded,
+    poisson_disk, random, sobol,
 };
-
-/// The dimensions a sampler supports and the one it uses by default.
-#[derive(Debug, Clone, Copy)]
-pub struct DimRange {
-    /// Smallest d.
-    pub min: usize,
-    /// Largest d.
-    pub max: usize,
-    /// d when none is given.
-    pub default: usize,
-}
-
-/// One `--param key=value` a sampler accepts.
-#[derive(Debug, Clone, Copy)]
-pub struct ParamInfo {
-    /// The key.
-    pub key: &'static str,
-    /// The default value, as text.
-    pub default: &'static str,
-    /// What it means.
-    pub help: &'static str,
-}
 
 /// A registered sampler.
 pub struct SamplerInfo {
@@ -44,7 +26,7 @@ pub struct SamplerInfo {
     pub count: &'static str,
     /// Accepted parameters.
     pub params: &'static [ParamInfo],
-    pub(super) build: fn(&Config) -> Result<Box<dyn Sampler>, SamplerError>,
+    pub(crate) build: fn(&Config) -> Result<Box<dyn Sampler>, SamplerError>,
 }
 
 const ANY: DimRange = DimRange {
@@ -280,69 +262,6 @@ pub const SAMPLERS: &[SamplerInfo] = &[
     },
 ];
 
-/// A validated request, handed to a sampler's constructor.
-pub(super) struct Config {
-    pub sampler: &'static str,
-    pub n: usize,
-    pub dim: usize,
-    params: Vec<(String, String)>,
-    info: &'static SamplerInfo,
-}
-
-impl Config {
-    /// The value of `key`, or its registered default.
-    pub fn param(&self, key: &'static str) -> &str {
-        self.params
-            .iter()
-            .rev()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.as_str())
-            .or_else(|| {
-                self.info
-                    .params
-                    .iter()
-                    .find(|p| p.key == key)
-                    .map(|p| p.default)
-            })
-            .expect("parameter keys are registered")
-    }
-
-    /// The value of `key` if it was given.
-    pub fn given(&self, key: &str) -> Option<&str> {
-        self.params
-            .iter()
-            .rev()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.as_str())
-    }
-
-    /// An error for parameter `key` saying what is expected.
-    pub fn bad_param(&self, key: &'static str, expected: impl Into<String>) -> SamplerError {
-        SamplerError::Param {
-            sampler: self.sampler,
-            key,
-            value: self.param(key).to_string(),
-            expected: expected.into(),
-        }
-    }
-
-    /// An error saying N must satisfy `rule`, with the nearest valid counts.
-    pub fn bad_count(
-        &self,
-        rule: &'static str,
-        below: Option<usize>,
-        above: Option<usize>,
-    ) -> SamplerError {
-        SamplerError::Count {
-            sampler: self.sampler,
-            n: self.n,
-            rule,
-            below,
-            above,
-        }
-    }
-}
-
 /// The sampler registered under `name` or one of its aliases.
 ///
 /// # Errors
@@ -438,13 +357,7 @@ pub fn build(
             },
         });
     }
-    let config = Config {
-        sampler,
-        n,
-        dim,
-        params: params.to_vec(),
-        info,
-    };
+    let config = Config::new(sampler, n, dim, params.to_vec(), info.params, build);
     (info.build)(&config)
 }
 
@@ -473,37 +386,9 @@ pub fn build_nearest(
     }
 }
 
-/// The integer `⌊n^(1/d)⌋`, exactly.
-pub(super) fn integer_root(n: usize, d: usize) -> usize {
-    let fits = |m: usize| m.checked_pow(d as u32).is_some_and(|p| p <= n);
-    let mut m = (n as f64).powf(1.0 / d as f64).round() as usize;
-    while m > 0 && !fits(m) {
-        m -= 1;
-    }
-    while fits(m + 1) {
-        m += 1;
-    }
-    m
-}
-
-/// `m^d`, saturating at `usize::MAX`.
-pub(super) fn pow_saturating(m: usize, d: usize) -> usize {
-    m.checked_pow(d as u32).unwrap_or(usize::MAX)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn integer_root_is_exact() {
-        assert_eq!(integer_root(1, 2), 1);
-        assert_eq!(integer_root(99, 2), 9);
-        assert_eq!(integer_root(100, 2), 10);
-        assert_eq!(integer_root(124, 3), 4);
-        assert_eq!(integer_root(125, 3), 5);
-        assert_eq!(integer_root(usize::MAX, 2), 4_294_967_295);
-    }
 
     #[test]
     fn names_and_aliases_are_unique() {
