@@ -383,17 +383,18 @@ impl NufftPlan {
             match &self.polynomial {
                 Some(p) => p.eval(2.0 * (first - start) - 1.0, &mut weights[dim][..w]),
                 None => {
-                    for a in 0..w {
+                    for (a, weight) in weights[dim][..w].iter_mut().enumerate() {
                         let z = 2.0 * (first + a as f64 - t) / w as f64;
-                        weights[dim][a] = kernel(z, self.beta);
+                        *weight = kernel(z, self.beta);
                     }
                 }
             }
-            for a in 0..w {
-                let l = first + a as f64;
-                cells[dim][a] = match origin {
-                    Some(o) if dim == d - 1 => (l as i64 - o) as usize,
-                    _ => (l as i64).rem_euclid(n as i64) as usize,
+            let first = first as i64;
+            for (a, cell) in cells[dim][..w].iter_mut().enumerate() {
+                let l = first + a as i64;
+                *cell = match origin {
+                    Some(o) if dim == d - 1 => (l - o) as usize,
+                    _ => l.rem_euclid(n as i64) as usize,
                 };
             }
         }
