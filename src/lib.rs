@@ -45,6 +45,7 @@ pub mod report;
 pub mod rng;
 pub mod samplers;
 pub mod scene;
+pub mod source;
 pub mod spectrum;
 pub mod square;
 pub mod sum;

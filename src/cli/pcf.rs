@@ -49,7 +49,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             bar.inc(1);
             source.get(r)
         })
-        .collect::<anyhow::Result<Vec<_>>>()?;
+        .collect::<Result<Vec<_>, _>>()?;
     bar.finish_and_clear();
     let (n, d) = (sets[0].len(), sets[0].dim());
     let unit = if d == 1 {

@@ -10,6 +10,7 @@ use serde_json::{Value, json};
 use super::source::SourceArgs;
 use varspec::PointSet;
 use varspec::integrands;
+use varspec::source::SourceError;
 use varspec::variance::{VarianceError, empirical, fourier_parts, radial_from, spatial};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -56,16 +57,14 @@ pub struct Args {
     json: bool,
 }
 
-/// Wraps a library error so `?` works inside the realization closures.
-fn lift(index: usize, e: anyhow::Error) -> VarianceError {
-    match e.downcast::<VarianceError>() {
-        Ok(v) => v,
-        Err(e) => match e.downcast::<varspec::samplers::SamplerError>() {
-            Ok(s) => VarianceError::Sampler(s),
-            Err(e) => VarianceError::Realization {
-                index,
-                message: format!("{e:#}"),
-            },
+/// A realization's failure as the predictor's error: a sampler failure
+/// stays one, anything else names the realization.
+fn lift(index: usize, e: SourceError) -> VarianceError {
+    match e {
+        SourceError::Sampler(s) => VarianceError::Sampler(s),
+        other => VarianceError::Realization {
+            index,
+            message: other.to_string(),
         },
     }
 }

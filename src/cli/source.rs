@@ -1,16 +1,16 @@
-//! Where analysed point sets come from: a point-set file, or fresh
-//! realizations of a sampler; optionally projected onto chosen dimensions.
+//! The command-line options that choose where analysed point sets come
+//! from (a point-set file, or fresh realizations of a sampler, optionally
+//! projected), resolved into the library's [`Source`].
 
 use std::path::PathBuf;
-use varspec::registry;
 
 use anyhow::{Context, bail};
 
 use super::args;
 use varspec::PointSet;
 use varspec::io::read_point_sets;
-use varspec::rng::set_rng;
-use varspec::samplers::Sampler;
+use varspec::registry;
+use varspec::source::Source;
 
 #[derive(clap::Args)]
 pub struct SourceArgs {
@@ -39,24 +39,6 @@ pub struct SourceArgs {
     /// points by 1/λ instead of 1/N.
     #[arg(long, value_name = "LAMBDA")]
     density: Option<f64>,
-}
-
-/// Resolved point sets, realization by realization.
-pub enum Source {
-    /// Sets read from a file.
-    File {
-        sets: Vec<PointSet>,
-        dims: Option<Vec<usize>>,
-        name: String,
-    },
-    /// A sampler and its seed.
-    Sampler {
-        sampler: Box<dyn Sampler>,
-        seed: u64,
-        sets: usize,
-        dims: Option<Vec<usize>>,
-        name: String,
-    },
 }
 
 impl SourceArgs {
@@ -149,97 +131,5 @@ impl SourceArgs {
             );
         }
         Ok(source)
-    }
-}
-
-impl Source {
-    /// Points per realization.
-    pub fn points_per_set(&self) -> usize {
-        match self {
-            Source::File { sets, .. } => sets[0].len(),
-            Source::Sampler { sampler, .. } => sampler.points_per_set(),
-        }
-    }
-
-    /// The density λ of a random-count source (`--density` for a file),
-    /// `None` for a fixed N.
-    pub fn density(&self) -> Option<f64> {
-        match self {
-            Source::File { sets, .. } => sets[0].density(),
-            Source::Sampler { sampler, .. } => sampler.density(),
-        }
-    }
-
-    /// "N = 256", "N = 243 to 268, each set weighed by 1/N" for a file of
-    /// sets of different sizes, or "random N, density 256" for a
-    /// random-count source.
-    pub fn count_label(&self) -> String {
-        let sizes = match self {
-            Source::File { sets, .. } => sets
-                .iter()
-                .map(PointSet::len)
-                .fold((usize::MAX, 0), |(lo, hi), n| (lo.min(n), hi.max(n))),
-            Source::Sampler { sampler, .. } => (sampler.points_per_set(), sampler.points_per_set()),
-        };
-        match (self.density(), sizes) {
-            (Some(density), _) => format!("random N, density {density}"),
-            (None, (lo, hi)) if lo != hi => format!(
-                "N = {lo} to {hi}, each set weighed by 1/N; --density gives a random-count process's 1/λ"
-            ),
-            (None, (n, _)) => format!("N = {n}"),
-        }
-    }
-
-    /// Every realization, projected: a file's sets, or the sampler's
-    /// `count()` draws made once (in parallel, each from its own stream) for
-    /// commands that pass over them several times.
-    pub fn realizations(&self) -> anyhow::Result<Vec<PointSet>> {
-        use rayon::prelude::*;
-        (0..self.count())
-            .into_par_iter()
-            .map(|r| self.get(r))
-            .collect()
-    }
-
-    /// Number of realizations.
-    pub fn count(&self) -> usize {
-        match self {
-            Source::File { sets, .. } => sets.len(),
-            Source::Sampler { sets, .. } => *sets,
-        }
-    }
-
-    /// A label for titles and messages.
-    pub fn name(&self) -> &str {
-        match self {
-            Source::File { name, .. } | Source::Sampler { name, .. } => name,
-        }
-    }
-
-    /// Realization r for estimators that need more realizations than the
-    /// source holds: a file's sets are reused cyclically, a sampler draws
-    /// fresh ones.
-    pub fn get_cyclic(&self, r: usize) -> anyhow::Result<PointSet> {
-        match self {
-            Source::File { sets, .. } => self.get(r % sets.len()),
-            Source::Sampler { .. } => self.get(r),
-        }
-    }
-
-    /// Realization r, projected.
-    pub fn get(&self, r: usize) -> anyhow::Result<PointSet> {
-        let (set, dims) = match self {
-            Source::File { sets, dims, .. } => (sets[r].clone(), dims),
-            Source::Sampler {
-                sampler,
-                seed,
-                dims,
-                ..
-            } => (sampler.sample(&mut set_rng(*seed, r as u64))?, dims),
-        };
-        match dims {
-            Some(d) => set.projected(d).with_context(|| self.name().to_string()),
-            None => Ok(set),
-        }
     }
 }

@@ -72,9 +72,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     check_memory(&freqs, method, a.res)?;
     let source = a.source.resolve(Some(2))?;
     let bar = progress::bar(source.count() as u64, "spectrum");
-    let spectrum = expected_power(freqs, method, source.count(), |r| source.get(r), &|| {
-        bar.inc(1)
-    })?;
+    let spectrum = expected_power(
+        freqs,
+        method,
+        source.count(),
+        |r| source.get(r).map_err(anyhow::Error::from),
+        &|| bar.inc(1),
+    )?;
     bar.finish_and_clear();
     let profile = radial_profile(&spectrum);
     let radial_csv = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
