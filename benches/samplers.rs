@@ -6,9 +6,9 @@
 
 use std::hint::black_box;
 use std::time::Duration;
-use varspec::registry;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use varspec::registry;
 use varspec::registry::SAMPLERS;
 use varspec::rng::set_rng;
 

@@ -11,12 +11,12 @@
 //! Writes `matrix.csv` to the folder and prints a markdown table.
 
 use std::time::Instant;
-use varspec::registry;
 
 use varspec::integrands;
 use varspec::optimize::adapted::design_sets;
 use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
+use varspec::registry;
 use varspec::rng::{set_rng, uniform};
 use varspec::samplers;
 use varspec::variance::{VarianceError, spatial};

@@ -15,9 +15,9 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
-use varspec::registry;
 
 use varspec::integrands;
+use varspec::registry;
 use varspec::samplers;
 use varspec::variance::{VarianceError, fit_slope, fourier_parts, radial_from, spatial};
 

@@ -16,8 +16,8 @@
 //! ```
 
 use std::time::Instant;
-use varspec::registry;
 
+use varspec::registry;
 use varspec::samplers::Sampler;
 use varspec::scene::Scene;
 use varspec::scene::analysis::SampleShear;

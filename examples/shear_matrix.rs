@@ -9,10 +9,10 @@
 //! ```
 
 use std::time::Instant;
-use varspec::registry;
 
 use varspec::integrands;
 use varspec::optimize::shear::{ObjectiveOptions, ShearObjective, search_shear, spectral_start};
+use varspec::registry;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args()

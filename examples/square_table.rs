@@ -11,9 +11,9 @@
 //! ```
 
 use std::time::Instant;
-use varspec::registry;
 
 use varspec::PointSet;
+use varspec::registry;
 use varspec::rng::{set_rng, uniform};
 use varspec::square::design::{closest_pair_ratio, default_options, design, parse_target};
 use varspec::square::{Family, family_mse};

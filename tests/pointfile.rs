@@ -2,13 +2,13 @@
 //! kind of malformed input.
 
 use std::path::Path;
-use varspec::registry;
 
 use varspec::PointSet;
 use varspec::io::pointfile::{
     LineProblem, PointFileError, parse_point_sets, read_point_sets_of_dim,
 };
 use varspec::io::{PointFormat, read_point_sets, write_atomic, write_point_sets};
+use varspec::registry;
 use varspec::rng::{PREV_ONE, set_rng};
 
 fn parse(text: &str) -> Result<Vec<PointSet>, PointFileError> {

@@ -3,13 +3,13 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
-use varspec::registry;
 
 use clap::Subcommand;
 use rustfft::num_complex::Complex64;
 
 use varspec::integrands;
 use varspec::io::write_atomic;
+use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::spectrum::dft::sample_spectrum;
 use varspec::spectrum::{FrequencyBox, Method, NufftPlan, Sign, SpectrumError, expected_power};

@@ -3,13 +3,13 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
-use varspec::registry;
 
 use anyhow::{Context, bail};
 
 use super::progress;
 use varspec::io::write_atomic;
 use varspec::neighbours::nearest_neighbour_distances;
+use varspec::registry;
 use varspec::report::png::{render_points, save_png};
 use varspec::samplers::{self, packing_radius};
 

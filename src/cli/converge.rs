@@ -2,7 +2,6 @@
 //! its confidence interval, beside the theoretical rate.
 
 use std::path::PathBuf;
-use varspec::registry;
 
 use anyhow::bail;
 use clap::ValueEnum;
@@ -12,6 +11,7 @@ use super::args::DrawArgs;
 use super::progress;
 use varspec::integrands;
 use varspec::io::write_atomic;
+use varspec::registry;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
 use varspec::rng::set_rng;
 use varspec::samplers;

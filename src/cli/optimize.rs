@@ -3,7 +3,6 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
-use varspec::registry;
 
 use anyhow::bail;
 use clap::Subcommand;
@@ -15,6 +14,7 @@ use varspec::io::{PointFormat, write_atomic, write_point_sets};
 use varspec::optimize::adapted::{Kept, design_sets};
 use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
+use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::samplers;
 

@@ -3,12 +3,12 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
-use varspec::registry;
 
 use anyhow::{Context, bail};
 
 use super::{args, progress};
 use varspec::io::write_atomic;
+use varspec::registry;
 use varspec::report::plot::{HeatMap, heatmap_png};
 use varspec::scene::analysis::{PixelKind, SampleShear};
 use varspec::scene::image::GreyImage;

@@ -2,7 +2,6 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use varspec::registry;
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
@@ -11,6 +10,7 @@ use super::{args, progress};
 use varspec::io::npy::write_point_sets_npy;
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
 use varspec::points::PointSet;
+use varspec::registry;
 use varspec::registry::SAMPLERS;
 use varspec::samplers;
 

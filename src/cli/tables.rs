@@ -1,7 +1,6 @@
 //! `varspec tables`: pattern tables for renderers, with metadata.
 
 use std::path::PathBuf;
-use varspec::registry;
 
 use anyhow::{Context, bail};
 use clap::ValueEnum;
@@ -12,6 +11,7 @@ use varspec::integrands;
 use varspec::io::read_point_sets;
 use varspec::io::tables::{TableFormat, TableMetadata, write_table};
 use varspec::io::write_atomic;
+use varspec::registry;
 use varspec::samplers;
 use varspec::variance::spatial_variance;
 

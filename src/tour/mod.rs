@@ -7,7 +7,6 @@
 
 pub mod html;
 
-use crate::registry;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -18,6 +17,7 @@ use crate::optimize::shear::{
     ObjectiveOptions, ShearObjective, Sheared, search_shear, spectral_start,
 };
 use crate::points::PointSet;
+use crate::registry;
 use crate::report::plot::{LinePlot, Series, line_plot_png, spectrum_png};
 use crate::report::png::{render_points, save_png};
 use crate::rng::set_rng;
