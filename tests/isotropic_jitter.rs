@@ -164,6 +164,27 @@ fn random_counts_are_refused_where_they_cannot_be_used() {
         .err()
         .unwrap();
     assert!(e.to_string().contains("225 or 256"), "{e}");
+    // One set with a density and one without: the Fourier form refuses
+    // and says which.
+    let f = integrands::parse("disk:r=0.3").unwrap();
+    let plain = PointSet::new(2, vec![0.1, 0.2, 0.6, 0.7]).unwrap();
+    let weighted = plain.clone().with_density(2.0).unwrap();
+    let mixed = [weighted, plain];
+    let e = fourier(f.as_ref(), 8, 1e-9, 2, |r| {
+        Ok::<_, VarianceError>(mixed[r].clone())
+    })
+    .expect_err("mixed sets are refused");
+    assert!(
+        matches!(
+            e,
+            VarianceError::MixedDensity {
+                first: Some(_),
+                other: None
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("--density"), "{e}");
     assert!(PointSet::new(2, vec![]).unwrap().with_density(0.0).is_err());
     assert!(
         PointSet::new(2, vec![])

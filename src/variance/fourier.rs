@@ -173,12 +173,13 @@ where
             match (first.density(), set.density()) {
                 (Some(a), Some(b)) if a == b => {}
                 (None, None) if set.len() == n => {}
-                _ => {
+                (None, None) => {
                     return Err(VarianceError::MixedSizes {
                         first: n,
                         other: set.len(),
                     });
                 }
+                (a, b) => return Err(VarianceError::MixedDensity { first: a, other: b }),
             }
             counts.lock().expect("no panics while held")[r] = set.len();
             Ok(set)

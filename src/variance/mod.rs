@@ -55,6 +55,19 @@ pub enum VarianceError {
         /// Another.
         other: usize,
     },
+    /// Realizations of random-count processes of different densities, or
+    /// mixed with fixed-N sets, in a Fourier prediction.
+    #[error(
+        "the Fourier predictor needs every set from one process: found density {} and {} \
+         (point files: give --density once for all sets)",
+        density_text(*first), density_text(*other)
+    )]
+    MixedDensity {
+        /// One set's density (`None`: a fixed-N set).
+        first: Option<f64>,
+        /// Another's.
+        other: Option<f64>,
+    },
     /// A realization could not be produced (a file's set, a projection).
     #[error("realization {index}: {message}")]
     Realization {
@@ -87,4 +100,8 @@ pub enum VarianceError {
     /// The spectrum could not be computed.
     #[error(transparent)]
     Spectrum(#[from] SpectrumError),
+}
+
+fn density_text(d: Option<f64>) -> String {
+    d.map_or("none (a fixed-N set)".into(), |v| v.to_string())
 }
