@@ -12,6 +12,14 @@ use varspec::{PointSet, rng::set_rng};
 
 const Z: f64 = 3.29;
 
+/// Sample mean, sample standard deviation and the mean's standard error.
+fn mean_sd_se(values: &[f64]) -> (f64, f64, f64) {
+    let r = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / r;
+    let sd = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (r - 1.0)).sqrt();
+    (mean, sd, sd / r.sqrt())
+}
+
 fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Vec<PointSet> {
     samplers::generate_sets(sampler, seed, sets, &|| {}).unwrap()
 }
@@ -25,10 +33,8 @@ fn counts_are_random_with_mean_lambda_and_points_inside_the_square() {
     // not bias. The check runs on 20,000 sets at seed 8.)
     let sets = draw(sampler.as_ref(), 8, 20000);
     let counts: Vec<f64> = sets.iter().map(|s| s.len() as f64).collect();
-    let r = counts.len() as f64;
-    let mean = counts.iter().sum::<f64>() / r;
-    let sd = (counts.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / (r - 1.0)).sqrt();
-    let half = Z * sd / r.sqrt();
+    let (mean, sd, se) = mean_sd_se(&counts);
+    let half = Z * se;
     assert!(
         (mean - 256.0).abs() <= half,
         "mean count {mean} outside 256 ± {half} (99.9%)"
@@ -54,10 +60,8 @@ fn the_weight_one_over_lambda_is_unbiased() {
             .iter()
             .map(|s| s.points().map(f).sum::<f64>() / s.intensity())
             .collect();
-        let r = est.len() as f64;
-        let mean = est.iter().sum::<f64>() / r;
-        let sd = (est.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (r - 1.0)).sqrt();
-        let half = Z * sd / r.sqrt();
+        let (mean, _, se) = mean_sd_se(&est);
+        let half = Z * se;
         assert!(
             (mean - integral).abs() <= half,
             "{name}: mean estimate {mean} outside {integral} ± {half} (99.9%)"
@@ -129,10 +133,8 @@ fn axis_alignment(sets: &[PointSet], radius: f64) -> (f64, f64) {
             total / pairs.max(1) as f64
         })
         .collect();
-    let r = per_set.len() as f64;
-    let mean = per_set.iter().sum::<f64>() / r;
-    let sd = (per_set.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (r - 1.0)).sqrt();
-    (mean, sd / r.sqrt())
+    let (mean, _, se) = mean_sd_se(&per_set);
+    (mean, se)
 }
 
 #[test]

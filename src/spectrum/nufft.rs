@@ -82,8 +82,7 @@ impl NufftPlan {
             return Err(SpectrumError::Tolerance(tolerance));
         }
         check_nufft_memory(&freqs)?;
-        let width = ((1.0 / tolerance).log10().ceil() as usize + 1).clamp(2, 16);
-        let beta = 2.30 * width as f64;
+        let (width, beta) = kernel_shape(tolerance);
         let grid = fine_grid_size(2 * freqs.side()).max(2 * width);
         let h = freqs.half as i64;
         let correction = (-h..=h)
@@ -272,16 +271,20 @@ impl NufftPlan {
         let height = rows + 2 * margin;
         let groups = n.div_ceil(rows);
         let row_len = n.pow(d as u32 - 1);
+        // Points `indices` onto `target`, whose last axis starts at row
+        // `origin` (a slab) or wraps (the whole grid).
+        let spread_into = |target: &mut [Complex64], indices: &[usize], origin: Option<i64>| {
+            for &j in indices {
+                let c = strengths.map_or(one, |s| s[j]);
+                self.for_each_grid_neighbour(points.point(j), origin, |cell, weight| {
+                    target[cell] += c * weight
+                });
+            }
+        };
         if groups < 2 || height > n {
             // One group: spread straight into the (periodic) grid.
             scratch.grid.fill(zero);
-            let grid = &mut scratch.grid;
-            for &j in order {
-                let c = strengths.map_or(one, |s| s[j]);
-                self.for_each_grid_neighbour(points.point(j), None, |cell, weight| {
-                    grid[cell] += c * weight
-                });
-            }
+            spread_into(&mut scratch.grid, order, None);
             return;
         }
         // The group of a point: its last coordinate's row over `rows`; bin
@@ -302,12 +305,7 @@ impl NufftPlan {
                 slab.clear();
                 slab.resize(height * row_len, zero);
                 let origin = (g * rows) as i64 - margin as i64;
-                for &j in &order[starts[g]..starts[g + 1]] {
-                    let c = strengths.map_or(one, |s| s[j]);
-                    self.for_each_grid_neighbour(points.point(j), Some(origin), |cell, weight| {
-                        slab[cell] += c * weight
-                    });
-                }
+                spread_into(slab, &order[starts[g]..starts[g + 1]], Some(origin));
             });
         let slabs = &scratch.slabs;
         scratch
@@ -648,6 +646,13 @@ impl KernelPolynomial {
     }
 }
 
+/// Width w = ⌈log10(1/ε)⌉ + 1 grid points (2 to 16) and β = 2.30·w of the
+/// kernel for tolerance ε (BMK 2019, §3 and Eq. (3.2)).
+fn kernel_shape(tolerance: f64) -> (usize, f64) {
+    let width = ((1.0 / tolerance).log10().ceil() as usize + 1).clamp(2, 16);
+    (width, 2.30 * width as f64)
+}
+
 /// The ES kernel φ(z) = exp(β(√(1 − z²) − 1)) on [−1, 1], 0 outside
 /// (BMK 2019, Eq. (1.8)).
 #[inline]
@@ -730,8 +735,7 @@ mod tests {
         // ε = 1e-3 … 1e-12 a low degree fits within ε/4 (checked against φ
         // at 2001 offsets here independently of the fit's own check).
         for tol in [1e-3, 1e-6, 1e-9, 1e-12] {
-            let w = ((1.0f64 / tol).log10().ceil() as usize + 1).clamp(2, 16);
-            let beta = 2.30 * w as f64;
+            let (w, beta) = kernel_shape(tol);
             let p = KernelPolynomial::fit(w, beta, tol).expect("a polynomial");
             assert!(p.degree <= w + 3, "tol {tol:e}: degree {}", p.degree);
             let mut out = vec![0.0; w];

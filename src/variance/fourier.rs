@@ -211,8 +211,7 @@ where
     }
     let nf = intensity;
     let counts = counts.into_inner().expect("no panics while held");
-    let i2 = f.integral() * f.integral();
-    let count_bias = |c: usize| (c as f64 / intensity - 1.0).powi(2) * i2;
+    let count_bias = |c: usize| super::count_term(c, intensity, f.integral());
     let count_term = crate::sum::sum(counts.iter().map(|&c| count_bias(c))) / sets as f64;
     let tail_mass = (f.variance() - mass.value()).max(0.0);
     let (bias, spread, pf_max) = if shell.is_empty() {

@@ -105,3 +105,11 @@ pub enum VarianceError {
 fn density_text(d: Option<f64>) -> String {
     d.map_or("none (a fixed-N set)".into(), |v| v.to_string())
 }
+
+/// The variance a random count adds to one set's squared error,
+/// (N/λ − 1)²·I² for N points drawn by a process of density λ (exactly 0
+/// when the intensity is N itself; docs/mathematics.md §2, "A random number
+/// of points"). The spatial and Fourier forms both add it.
+fn count_term(points: usize, intensity: f64, integral: f64) -> f64 {
+    (points as f64 / intensity - 1.0).powi(2) * integral * integral
+}

@@ -137,16 +137,17 @@ pub fn spatial_variance(points: &PointSet, f: &dyn Integrand) -> Result<(f64, f6
     let mut v = NeumaierSum::default();
     v.add(n as f64 * c0);
     v.add(2.0 * off_diagonal);
-    // (wN − 1)² I²: zero for w = 1/N, the random count's cost otherwise.
     let intensity = points.intensity();
-    let i2 = f.integral() * f.integral();
-    let count_bias = (n as f64 - intensity).powi(2) * i2;
-    v.add(count_bias);
     let n2 = intensity * intensity;
-    let rounding = 4.0 * f64::EPSILON * (n as f64 * c0.abs() + 2.0 * off_abs + count_bias) / n2;
-    // A variance is non-negative; a negative total is rounding noise, within
-    // `rounding` of 0.
-    Ok(((v.value() / n2).max(0.0), rounding))
+    let rounding = 4.0 * f64::EPSILON * (n as f64 * c0.abs() + 2.0 * off_abs) / n2;
+    // w² Σ c_f is a variance, non-negative; a negative total is rounding
+    // noise, within `rounding` of 0. Then (wN − 1)² I²: exactly 0 for
+    // w = 1/N, the random count's cost otherwise.
+    let pairs = (v.value() / n2).max(0.0);
+    Ok((
+        pairs + super::count_term(n, intensity, f.integral()),
+        rounding,
+    ))
 }
 
 /// The spatial prediction averaged over `sets` realizations.
