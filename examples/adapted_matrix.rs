@@ -109,7 +109,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let design =
                 |start: &dyn samplers::Sampler| -> Result<(f64, f64), Box<dyn std::error::Error>> {
                     let t = Instant::now();
-                    let kept = design_sets(&optimizer, start, Some(f.as_ref()), 3, 1, &|_, _| {})?;
+                    let kept =
+                        design_sets(&optimizer, start, Some(f.as_ref()), 3, 1, &|_, _| {}, None)?;
                     Ok((
                         kept[0].variance().expect("exact form"),
                         t.elapsed().as_secs_f64(),

@@ -104,6 +104,7 @@ fn adapted_design_beats_cmj_on_unseen_halfplanes() {
                 9,
                 1,
                 &|_, _| {},
+                None,
             )
             .unwrap();
             let ours = kept[0].variance().unwrap();

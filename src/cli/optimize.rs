@@ -11,12 +11,13 @@ use serde_json::json;
 
 use super::{args, progress};
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
-use varspec::optimize::adapted::{Kept, design_sets};
+use varspec::optimize::adapted::{CheckpointEvent, CheckpointPlan, Kept, design_sets};
 use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::samplers;
+use varspec::spectrum::nufft::nufft_memory_bytes;
 
 #[derive(Subcommand)]
 pub enum OptimizeCommand {
@@ -127,6 +128,15 @@ pub struct PointsArgs {
     /// Log-log PNG of set 0's loss against wall time, with the classic samplers' losses.
     #[arg(long)]
     curve_png: Option<PathBuf>,
+    /// Torus designs: save the descent's whole state here while it runs
+    /// (set r of several in PATH.r); a run given the same path continues
+    /// from it, with the same result as a run never stopped, and removes it
+    /// once the output is written.
+    #[arg(long)]
+    checkpoint: Option<PathBuf>,
+    /// Least wall time between two checkpoint saves, in seconds.
+    #[arg(long, default_value_t = 60.0)]
+    checkpoint_every: f64,
 }
 
 pub fn run(c: OptimizeCommand) -> anyhow::Result<()> {
@@ -152,10 +162,34 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     if a.sets == 0 {
         bail!("--sets must be at least 1");
     }
+    if !(a.checkpoint_every >= 0.0 && a.checkpoint_every.is_finite()) {
+        bail!(
+            "--checkpoint-every {}: give a number of seconds >= 0",
+            a.checkpoint_every
+        );
+    }
+    let projections = a.dim == 4 && varspec::optimize::projections::is_projection_target(&a.target);
+    if a.checkpoint.is_some() && (a.domain == DomainArg::Square || projections) {
+        bail!(
+            "--checkpoint saves torus descents toward one target; {} designs do not take it",
+            if projections {
+                "4D projection-target"
+            } else {
+                "--domain square"
+            }
+        );
+    }
+    if let Some(path) = &a.checkpoint {
+        for r in 0..a.sets {
+            varspec::io::check_output(&varspec::optimize::adapted::checkpoint_path(
+                path, r, a.sets,
+            ))?;
+        }
+    }
     if a.domain == DomainArg::Square {
         return points_square(a);
     }
-    if a.dim == 4 && varspec::optimize::projections::is_projection_target(&a.target) {
+    if projections {
         return points_projections(a);
     }
     let target = Target::parse(&a.target)?;
@@ -221,7 +255,58 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     } else {
         (registry::build(&init_name, a.n, Some(a.dim), &[])?, None)
     };
+    let plan_bytes = nufft_memory_bytes(optimizer.frequencies()).unwrap_or(f64::INFINITY);
+    let memory =
+        plan_bytes + rayon::current_num_threads().min(a.sets) as f64 * optimizer.descent_bytes(a.n);
+    varspec::memory::check(
+        &format!("the descent of {} points on a box |k| <= {half}", a.n),
+        Some(memory),
+        "lower -n or --res",
+    )?;
+    println!(
+        "memory: about {:.0} MiB (box |k| <= {half}: {} frequencies; {} set(s) at a time)",
+        memory / (1024.0 * 1024.0),
+        optimizer.frequencies().len(),
+        rayon::current_num_threads().min(a.sets)
+    );
     let bar = progress::bar((a.sets * iters) as u64, "optimizing");
+    let run = format!(
+        "optimize points -n {} -d {} --target {} --init {init_name} --seed {} --iters {iters} --res {} --tol {options_tolerance:e} --rel-tol {:e}",
+        a.n,
+        a.dim,
+        a.target,
+        a.seed,
+        2 * half + 1,
+        a.rel_tol
+            .unwrap_or(DescentOptions::for_target(a.n, a.dim, &target).rel_tol),
+    );
+    let on_event = |event: CheckpointEvent| match event {
+        CheckpointEvent::Resumed {
+            set,
+            iteration,
+            path,
+        } => {
+            bar.inc(iteration as u64);
+            bar.suspend(|| {
+                eprintln!(
+                    "set {set}: continuing from iteration {iteration} saved in {}",
+                    path.display()
+                )
+            });
+        }
+        CheckpointEvent::Saved { .. } => {}
+        CheckpointEvent::Failed { set, error } => {
+            bar.suspend(|| {
+                eprintln!("warning: set {set}: checkpoint not saved ({error}); the descent goes on")
+            });
+        }
+    };
+    let checkpoint = a.checkpoint.as_deref().map(|path| CheckpointPlan {
+        path,
+        run: &run,
+        every: std::time::Duration::from_secs_f64(a.checkpoint_every),
+        on_event: &on_event,
+    });
     let results = design_sets(
         &optimizer,
         init.as_ref(),
@@ -229,11 +314,22 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         a.seed,
         a.sets,
         &|_, _| bar.inc(1),
+        checkpoint.as_ref(),
     )?;
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     let sets: Vec<_> = results.iter().map(|r| r.points.clone()).collect();
     write_atomic(&a.output, |w| write_point_sets(w, &sets, PointFormat::Csv))?;
+    if let Some(path) = &a.checkpoint {
+        for r in 0..a.sets {
+            let file = varspec::optimize::adapted::checkpoint_path(path, r, a.sets);
+            match std::fs::remove_file(&file) {
+                Ok(()) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => eprintln!("warning: checkpoint {} not removed: {e}", file.display()),
+            }
+        }
+    }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     let final_losses: Vec<f64> = results
         .iter()

@@ -79,6 +79,84 @@ pub struct DescentResult {
     pub start_score: f64,
 }
 
+/// Everything the descent needs to go on from iteration `t`: positions,
+/// Adam's moments, the best set so far and the history. A run continued
+/// from a saved state takes the same steps, bit for bit, as one never
+/// stopped (the objectives depend on the positions and on `t` only).
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdamState {
+    /// Dimension of the points.
+    pub dim: usize,
+    /// The next iteration.
+    pub t: usize,
+    /// Positions, point-major.
+    pub x: Vec<f64>,
+    /// First moment.
+    pub m: Vec<f64>,
+    /// Second moment.
+    pub v: Vec<f64>,
+    /// Best score so far (infinite before the first).
+    pub best_score: f64,
+    /// Positions of the best score.
+    pub best_x: Vec<f64>,
+    /// The start's score (NaN before the first).
+    pub start_score: f64,
+    /// Factor on the rate, halved by each recovery.
+    pub damping: f64,
+    /// Steps since the moments were last reset (Adam's bias correction).
+    pub since_reset: i32,
+    /// Scores so far (the stopping test looks 50 back).
+    pub scores: Vec<f64>,
+    /// Loss of every iteration so far.
+    pub losses: Vec<f64>,
+    /// Wall time at every entry of `losses`, in seconds since the run began
+    /// (across restarts).
+    pub seconds: Vec<f64>,
+}
+
+impl AdamState {
+    /// The state before the first step from `start`.
+    pub fn start(start: &PointSet) -> Self {
+        let x = start.coords().to_vec();
+        let zeros = vec![0.0; x.len()];
+        AdamState {
+            dim: start.dim(),
+            t: 0,
+            m: zeros.clone(),
+            v: zeros,
+            best_score: f64::INFINITY,
+            best_x: x.clone(),
+            x,
+            start_score: f64::NAN,
+            damping: 1.0,
+            since_reset: 0,
+            scores: Vec::new(),
+            losses: Vec::new(),
+            seconds: Vec::new(),
+        }
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.x.len() / self.dim.max(1)
+    }
+
+    /// Whether the state holds no point.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+}
+
+/// Saving the state while the descent runs: `save` receives it at the top
+/// of an iteration once `every` has passed since the last save (the run
+/// itself does not change: saving only reads the state).
+pub struct Checkpointing<'a> {
+    /// Least wall time between two saves.
+    pub every: std::time::Duration,
+    /// Called with the state to save.
+    pub save: &'a (dyn Fn(&AdamState) + Sync),
+}
+
 /// Descends from `start`; `on_iteration(t, loss)` is called every step.
 pub fn adam(
     start: PointSet,
@@ -87,27 +165,49 @@ pub fn adam(
     domain: Domain,
     on_iteration: &dyn Fn(usize, f64),
 ) -> DescentResult {
-    let (n, d) = (start.len(), start.dim());
+    adam_from(
+        AdamState::start(&start),
+        objective,
+        options,
+        domain,
+        on_iteration,
+        None,
+    )
+}
+
+/// Descends from a saved (or fresh) `state`, saving it as `checkpointing`
+/// says; `on_iteration(t, loss)` is called every step.
+pub fn adam_from(
+    mut s: AdamState,
+    objective: &dyn PointObjective,
+    options: &AdamOptions,
+    domain: Domain,
+    on_iteration: &dyn Fn(usize, f64),
+    checkpointing: Option<&Checkpointing>,
+) -> DescentResult {
+    let (n, d) = (s.len(), s.dim);
     let o = options;
     let spacing = (1.0 / n.max(1) as f64).powf(1.0 / d as f64);
     let (beta1, beta2, eps) = (0.9f64, 0.999f64, 1e-300f64);
-    let mut x = start.coords().to_vec();
-    let (mut m, mut v) = (vec![0.0; n * d], vec![0.0; n * d]);
     let mut grad = vec![0.0; n * d];
-    let mut best = (f64::INFINITY, x.clone());
-    let mut start_score = f64::NAN;
-    let mut losses = Vec::with_capacity(o.iters + 1);
-    let mut seconds = Vec::with_capacity(o.iters + 1);
-    let mut scores: Vec<f64> = Vec::new();
+    let offset = s.seconds.last().copied().unwrap_or(0.0);
     let clock = std::time::Instant::now();
-    let mut damping = 1.0;
-    let mut since_reset = 0i32;
-    for t in 0..o.iters {
-        let points = PointSet::new(d, x.clone()).expect("confined coordinates lie in [0,1)");
+    let mut last_save = clock;
+    while s.t < o.iters {
+        let t = s.t;
+        if let Some(c) = checkpointing
+            && t > 0
+            && last_save.elapsed() >= c.every
+        {
+            (c.save)(&s);
+            last_save = std::time::Instant::now();
+        }
+        s.t += 1;
+        let points = PointSet::new(d, s.x.clone()).expect("confined coordinates lie in [0,1)");
         grad.fill(0.0);
         let loss = objective.loss_and_gradient(&points, t, &mut grad);
-        losses.push(loss);
-        seconds.push(clock.elapsed().as_secs_f64());
+        s.losses.push(loss);
+        s.seconds.push(offset + clock.elapsed().as_secs_f64());
         on_iteration(t, loss);
         let scored = if o.score_every <= 1 {
             Some(loss)
@@ -118,51 +218,56 @@ pub fn adam(
         };
         if let Some(score) = scored {
             if t == 0 {
-                start_score = score;
+                s.start_score = score;
             }
-            scores.push(score);
-            if score < best.0 {
-                best = (score, x.clone());
-            } else if score > 1.5 * best.0 {
+            s.scores.push(score);
+            if score < s.best_score {
+                s.best_score = score;
+                s.best_x.clone_from(&s.x);
+            } else if score > 1.5 * s.best_score {
                 // Undo steps that blew up; take smaller ones from the best set.
-                x.clone_from(&best.1);
-                m.fill(0.0);
-                v.fill(0.0);
-                since_reset = 0;
-                damping *= 0.5;
+                s.x.clone_from(&s.best_x);
+                s.m.fill(0.0);
+                s.v.fill(0.0);
+                s.since_reset = 0;
+                s.damping *= 0.5;
                 continue;
             }
-            let s = scores.len();
-            if o.rel_tol > 0.0 && s > 50 && scores[s - 51] - score < o.rel_tol * score {
+            let k = s.scores.len();
+            if o.rel_tol > 0.0 && k > 50 && s.scores[k - 51] - score < o.rel_tol * score {
                 break;
             }
         }
         let progress = t as f64 / o.iters as f64;
-        let lr = damping * spacing * o.step * (o.final_step / o.step).powf(progress);
-        since_reset += 1;
-        let (c1, c2) = (1.0 - beta1.powi(since_reset), 1.0 - beta2.powi(since_reset));
-        for i in 0..n * d {
-            m[i] = beta1 * m[i] + (1.0 - beta1) * grad[i];
-            v[i] = beta2 * v[i] + (1.0 - beta2) * grad[i] * grad[i];
-            let step = lr * (m[i] / c1) / ((v[i] / c2).sqrt() + eps);
-            x[i] = domain.confine(x[i] - step);
+        let lr = s.damping * spacing * o.step * (o.final_step / o.step).powf(progress);
+        s.since_reset += 1;
+        let (c1, c2) = (
+            1.0 - beta1.powi(s.since_reset),
+            1.0 - beta2.powi(s.since_reset),
+        );
+        for (((x, m), v), g) in s.x.iter_mut().zip(&mut s.m).zip(&mut s.v).zip(&grad) {
+            *m = beta1 * *m + (1.0 - beta1) * g;
+            *v = beta2 * *v + (1.0 - beta2) * g * g;
+            let step = lr * (*m / c1) / ((*v / c2).sqrt() + eps);
+            *x = domain.confine(*x - step);
         }
     }
     // A stochastic objective's last iterate is scored too.
     if o.score_every > 1 {
-        let points = PointSet::new(d, x.clone()).expect("confined coordinates lie in [0,1)");
+        let points = PointSet::new(d, s.x.clone()).expect("confined coordinates lie in [0,1)");
         if let Some(score) = objective.score(&points)
-            && score < best.0
+            && score < s.best_score
         {
-            best = (score, x);
+            s.best_score = score;
+            s.best_x = s.x;
         }
     }
-    let points = PointSet::new(d, best.1).expect("confined coordinates lie in [0,1)");
+    let points = PointSet::new(d, s.best_x).expect("confined coordinates lie in [0,1)");
     DescentResult {
         points,
-        losses,
-        seconds,
-        best_score: best.0,
-        start_score,
+        losses: s.losses,
+        seconds: s.seconds,
+        best_score: s.best_score,
+        start_score: s.start_score,
     }
 }

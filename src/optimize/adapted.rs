@@ -9,10 +9,16 @@
 //! truncation) decides between the descent's set and its start, and the
 //! result says which was kept: a start is never passed off as optimized.
 
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
 use rayon::prelude::*;
 
+use super::adam::{AdamState, Checkpointing};
+use super::checkpoint;
 use super::{DescentResult, OptimizeError, PointOptimizer};
 use crate::integrands::Integrand;
+use crate::io::WriteError;
 use crate::points::PointSet;
 use crate::rng::set_rng;
 use crate::samplers::Sampler;
@@ -115,12 +121,69 @@ pub fn keep_lower_variance(
     })
 }
 
+/// Checkpoints of [`design_sets`]: set r of several is saved to `PATH.r`,
+/// a single set to `PATH` ([`checkpoint_path`]); `on_event` hears of every
+/// resume, save and failed save (a failed save does not stop the descent).
+pub struct CheckpointPlan<'a> {
+    /// Where set 0 (of one) is saved.
+    pub path: &'a Path,
+    /// The run's description; a checkpoint of another run is refused.
+    pub run: &'a str,
+    /// Least wall time between saves.
+    pub every: Duration,
+    /// Told of each resume, save and failure.
+    pub on_event: &'a (dyn Fn(CheckpointEvent) + Sync),
+}
+
+/// What happened to a checkpoint.
+#[derive(Debug)]
+pub enum CheckpointEvent<'a> {
+    /// Set `set` continues from iteration `iteration` saved at `path`.
+    Resumed {
+        /// The set.
+        set: usize,
+        /// Its next iteration.
+        iteration: usize,
+        /// The file.
+        path: &'a Path,
+    },
+    /// Set `set` was saved at iteration `iteration`.
+    Saved {
+        /// The set.
+        set: usize,
+        /// Its next iteration.
+        iteration: usize,
+        /// The file.
+        path: &'a Path,
+    },
+    /// Saving set `set` failed; the descent goes on.
+    Failed {
+        /// The set.
+        set: usize,
+        /// Why.
+        error: &'a WriteError,
+    },
+}
+
+/// The checkpoint file of set `set` of `sets` with base path `path`.
+pub fn checkpoint_path(path: &Path, set: usize, sets: usize) -> PathBuf {
+    if sets == 1 {
+        return path.to_path_buf();
+    }
+    let mut name = path.as_os_str().to_owned();
+    name.push(format!(".{set}"));
+    PathBuf::from(name)
+}
+
 /// `sets` designs: realization r of `start` (stream (seed, r)) descended by
 /// `optimizer`, each kept by [`keep_lower_variance`] when `exact` is given.
-/// Sets run in parallel; each is independent of the thread count.
+/// Sets run in parallel; each is independent of the thread count. With a
+/// `checkpoint` plan each set continues from its saved state when there is
+/// one, and the result is the same, bit for bit, as a run never stopped.
 ///
 /// # Errors
-/// A failed realization of the start, or the exact form.
+/// A failed realization of the start, the exact form, or a checkpoint that
+/// is damaged or belongs to another run.
 pub fn design_sets(
     optimizer: &PointOptimizer,
     start: &dyn Sampler,
@@ -128,12 +191,45 @@ pub fn design_sets(
     seed: u64,
     sets: usize,
     on_iteration: &(dyn Fn(usize, f64) + Sync),
+    checkpoint: Option<&CheckpointPlan>,
 ) -> Result<Vec<Kept>, OptimizeError> {
     (0..sets)
         .into_par_iter()
         .map(|r| {
             let first = start.sample(&mut set_rng(seed, r as u64))?;
-            let descended = optimizer.optimize(first.clone(), on_iteration);
+            let descended = match checkpoint {
+                None => optimizer.optimize(first.clone(), on_iteration),
+                Some(plan) => {
+                    let path = checkpoint_path(plan.path, r, sets);
+                    let state = match checkpoint::load(&path, plan.run)? {
+                        Some(saved) => {
+                            (plan.on_event)(CheckpointEvent::Resumed {
+                                set: r,
+                                iteration: saved.t,
+                                path: &path,
+                            });
+                            saved
+                        }
+                        None => AdamState::start(&first),
+                    };
+                    let save = |s: &AdamState| match checkpoint::save(&path, plan.run, s) {
+                        Ok(()) => (plan.on_event)(CheckpointEvent::Saved {
+                            set: r,
+                            iteration: s.t,
+                            path: &path,
+                        }),
+                        Err(error) => (plan.on_event)(CheckpointEvent::Failed {
+                            set: r,
+                            error: &error,
+                        }),
+                    };
+                    let checkpointing = Checkpointing {
+                        every: plan.every,
+                        save: &save,
+                    };
+                    optimizer.optimize_from(state, on_iteration, Some(&checkpointing))
+                }
+            };
             Ok(match exact {
                 Some(f) => keep_lower_variance(first, descended, f)?,
                 None => Kept::descended(descended),

@@ -13,7 +13,9 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::adam::{AdamOptions, DescentResult, Domain, PointObjective, adam};
+use super::adam::{
+    AdamOptions, AdamState, Checkpointing, DescentResult, Domain, PointObjective, adam_from,
+};
 use super::{OptimizeError, Target};
 use crate::points::PointSet;
 use crate::spectrum::nufft::NufftScratch;
@@ -153,6 +155,16 @@ impl PointOptimizer {
         })
     }
 
+    /// Bytes one descent of `n` points holds, besides the plan's shared
+    /// grids ([`crate::spectrum::nufft::nufft_memory_bytes`]): spectrum,
+    /// coefficients and weights on the box, values at the points, and
+    /// Adam's positions, moments, best set and gradient (eight copies of
+    /// N·d coordinates with the point sets built from them).
+    pub fn descent_bytes(&self, n: usize) -> f64 {
+        let len = self.freqs.len() as f64;
+        len * 40.0 + n as f64 * (16.0 + 8.0 * 8.0 * self.freqs.dim as f64)
+    }
+
     /// The weights W(k) in box order.
     pub fn weights(&self) -> &[f64] {
         &self.weights
@@ -237,6 +249,17 @@ impl PointOptimizer {
     /// Descends from `start` by [`adam`] on the torus; `on_iteration(t,
     /// loss)` is called every step.
     pub fn optimize(&self, start: PointSet, on_iteration: &dyn Fn(usize, f64)) -> DescentResult {
+        self.optimize_from(AdamState::start(&start), on_iteration, None)
+    }
+
+    /// Descends from a fresh or saved `state` (see [`adam_from`]), saving it
+    /// as `checkpointing` says.
+    pub fn optimize_from(
+        &self,
+        state: AdamState,
+        on_iteration: &dyn Fn(usize, f64),
+        checkpointing: Option<&Checkpointing>,
+    ) -> DescentResult {
         let o = &self.options;
         let adam_options = AdamOptions {
             iters: o.iters,
@@ -247,14 +270,15 @@ impl PointOptimizer {
         };
         let objective = TorusObjective {
             optimizer: self,
-            work: std::sync::Mutex::new(self.work(start.len())),
+            work: std::sync::Mutex::new(self.work(state.len())),
         };
-        adam(
-            start,
+        adam_from(
+            state,
             &objective,
             &adam_options,
             Domain::Torus,
             on_iteration,
+            checkpointing,
         )
     }
 }

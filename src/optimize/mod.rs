@@ -4,6 +4,7 @@
 
 pub mod adam;
 pub mod adapted;
+pub mod checkpoint;
 pub mod descent;
 pub mod lattice;
 pub mod projections;
@@ -11,7 +12,9 @@ pub mod repulsion;
 pub mod shear;
 pub mod target;
 
-pub use adam::{AdamOptions, DescentResult, Domain, PointObjective, adam};
+pub use adam::{
+    AdamOptions, AdamState, Checkpointing, DescentResult, Domain, PointObjective, adam, adam_from,
+};
 pub use descent::{DescentOptions, PointOptimizer};
 pub use target::Target;
 
@@ -44,6 +47,9 @@ pub enum OptimizeError {
     /// A variance predictor failed.
     #[error(transparent)]
     Variance(#[from] crate::variance::VarianceError),
+    /// A checkpoint could not be resumed.
+    #[error(transparent)]
+    Checkpoint(#[from] checkpoint::CheckpointError),
     /// argmin reported an error.
     #[error("shear search failed: {0}")]
     Search(String),

@@ -677,6 +677,18 @@ fn kernel_transform(xi: f64, width: usize, beta: f64) -> f64 {
     0.5 * w * sum
 }
 
+/// Bytes a plan on `freqs` holds at most: a fine grid of twice the box's
+/// side per thread (four buffers) and 24 bytes per frequency; `None` when
+/// the box's size overflows.
+pub fn nufft_memory_bytes(freqs: &FrequencyBox) -> Option<f64> {
+    let threads = rayon::current_num_threads() as f64;
+    let side = freqs.side() as f64;
+    let d = freqs.dim as i32;
+    freqs
+        .checked_len()
+        .map(|len| threads * 4.0 * (2.0 * side).powi(d) * 16.0 + len as f64 * 24.0)
+}
+
 /// The smallest 2^a·3^b·5^c ≥ `min` (sizes RustFFT handles fastest).
 /// Refuses a box whose transform would not fit in memory: each thread holds
 /// two complex fine grids of at least (2(2h+1))^d cells and the spreading
@@ -685,12 +697,7 @@ fn kernel_transform(xi: f64, width: usize, beta: f64) -> f64 {
 /// # Errors
 /// [`SpectrumError::TooLarge`] with the estimate.
 pub fn check_nufft_memory(freqs: &FrequencyBox) -> Result<(), SpectrumError> {
-    let threads = rayon::current_num_threads() as f64;
-    let side = freqs.side() as f64;
-    let d = freqs.dim as i32;
-    let bytes = freqs
-        .checked_len()
-        .map(|len| threads * 4.0 * (2.0 * side).powi(d) * 16.0 + len as f64 * 24.0);
+    let bytes = nufft_memory_bytes(freqs);
     crate::memory::check(
         &format!(
             "a non-uniform FFT on the {}^{} frequency box (|k| <= {})",
