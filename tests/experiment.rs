@@ -115,3 +115,59 @@ fn a_rerun_with_one_n_removes_the_stale_slopes() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn duplicates_after_adjustment_are_refused_naming_the_values() {
+    let cases = [
+        // jitter takes square N: 60 and 64 both become 64.
+        (
+            SMALL.replace("[16, 64, 256]", "[60, 64]"),
+            "n = 60 and 64 both become N = 64 for `jitter`",
+        ),
+        (
+            SMALL.replace("\"gaussian:sx=0.1\"", "\"disk\""),
+            "are the same integrand (disk:r=0.3,cx=0.5,cy=0.5)",
+        ),
+        (
+            SMALL.replace("\"cmj\"", "\"jitter\""),
+            "sampler `jitter` is listed twice",
+        ),
+        (
+            SMALL.replace("\"cmj\"", "\"nonesuch\""),
+            "sampler `nonesuch` at n = 16",
+        ),
+    ];
+    let dir = temp_dir("experiment-duplicates");
+    for (text, said) in &cases {
+        let file = dir.join("dup.json");
+        std::fs::write(&file, text).unwrap();
+        let out = dir.join("out");
+        assert_fails(
+            &[
+                "experiment",
+                file.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            said,
+        );
+        assert!(!out.exists(), "a refused experiment left a folder");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_shipped_experiment_files_are_valid() {
+    let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&folder).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "json") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            varspec::experiment::Experiment::parse(&text, &path.display().to_string())
+                .unwrap_or_else(|e| panic!("{e}"));
+            checked += 1;
+        }
+    }
+    assert!(checked >= 4, "only {checked} experiment files found");
+}

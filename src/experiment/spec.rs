@@ -84,14 +84,41 @@ impl Experiment {
             ));
         }
         let mut dims = Vec::new();
+        let mut canonical: Vec<String> = Vec::new();
         for spec in &e.integrands {
             let f = crate::integrands::parse(spec).map_err(|err| invalid(err.to_string()))?;
+            if let Some(i) = canonical.iter().position(|c| *c == f.spec()) {
+                return Err(invalid(format!(
+                    "integrands `{}` and `{spec}` are the same integrand ({}): list each once",
+                    e.integrands[i],
+                    f.spec()
+                )));
+            }
+            canonical.push(f.spec());
             dims.push(f.dim());
         }
         if dims.iter().any(|&d| d != dims[0]) {
             return Err(invalid(
                 "all integrands of an experiment must have the same dimension".into(),
             ));
+        }
+        for (i, sampler) in e.samplers.iter().enumerate() {
+            if e.samplers[..i].contains(sampler) {
+                return Err(invalid(format!("sampler `{sampler}` is listed twice")));
+            }
+            let mut used: Vec<(usize, usize)> = Vec::new();
+            for &requested in &e.n {
+                let (_, n) = crate::registry::build_nearest(sampler, requested, Some(dims[0]), &[])
+                    .map_err(|err| {
+                        invalid(format!("sampler `{sampler}` at n = {requested}: {err}"))
+                    })?;
+                if let Some((earlier, _)) = used.iter().find(|(_, m)| *m == n) {
+                    return Err(invalid(format!(
+                        "n = {earlier} and {requested} both become N = {n} for `{sampler}` (its nearest valid N): give N values that stay distinct"
+                    )));
+                }
+                used.push((requested, n));
+            }
         }
         Ok(e)
     }
