@@ -49,6 +49,18 @@ impl DrawArgs {
         self.sets_given.unwrap_or(16)
     }
 
+    /// Refuses more sets than the machine can hold results for: analyses
+    /// draw sets one at a time but keep a few numbers per set (estimates,
+    /// sums), 64 bytes an ample bound.
+    pub fn check_results_memory(&self) -> anyhow::Result<()> {
+        varspec::memory::check(
+            &format!("the per-set results of {} realizations", self.sets()),
+            Some(self.sets() as f64 * 64.0),
+            "lower --sets",
+        )?;
+        Ok(())
+    }
+
     /// Refuses --sets and --param where sets come from a file (they would
     /// be silently ignored).
     pub fn refuse_with_file(&self, file: &std::path::Path) -> anyhow::Result<()> {

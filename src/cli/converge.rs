@@ -81,6 +81,10 @@ enum Subject {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
+    a.draw.check_results_memory()?;
+    if a.family.is_some() {
+        varspec::square::mse::check_family_memory(a.members, a.draw.sets())?;
+    }
     let subject = match (&a.integrand, &a.family) {
         (Some(spec), _) => Subject::Torus(integrands::parse(spec)?),
         (None, Some(spec)) => {

@@ -215,6 +215,7 @@ fn square(a: &Args) -> anyhow::Result<()> {
 
     let family = Family::parse(a.family.as_deref().unwrap_or_default())?;
     let source = a.source.resolve(Some(2))?;
+    varspec::square::mse::check_family_memory(a.members, source.count())?;
     let sets = source.realizations()?;
     let n = source.points_per_set();
     let start = Instant::now();

@@ -130,6 +130,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         )
     })?;
     let [w, h] = scene.camera().resolution();
+    // Every thread holds one pixel's set (and its sheared copy) at a time.
+    varspec::memory::check(
+        &format!("{} spp per pixel", a.spp),
+        Some(rayon::current_num_threads() as f64 * 2.0 * a.spp as f64 * 4.0 * 8.0),
+        "lower --spp",
+    )?;
     let start = Instant::now();
     let analysis = analyse(&scene);
     let shears = pixel_shears(&scene, sampler.as_ref(), policy, &analysis, a.seed)?;

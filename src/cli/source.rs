@@ -90,6 +90,7 @@ impl SourceArgs {
                 if self.draw.sets() == 0 {
                     bail!("--sets must be at least 1");
                 }
+                self.draw.check_results_memory()?;
                 let n = self.n.context("--sampler needs -n")?;
                 let sampler = registry::build(name, n, self.dim, &self.draw.params)?;
                 Source::Sampler {

@@ -109,6 +109,9 @@ pub enum SamplerError {
         /// Smallest valid N above, if any.
         above: Option<usize>,
     },
+    /// The realizations asked for do not fit in memory.
+    #[error(transparent)]
+    Memory(#[from] crate::memory::TooMuchMemory),
     /// N·d is too large to hold.
     #[error(
         "{sampler}: {n} points in {dim} dimensions is more than this tool holds (fewer than 2^32 coordinates)"
@@ -183,13 +186,25 @@ fn nearest(below: Option<usize>, above: Option<usize>) -> String {
 /// finished set (for progress display).
 ///
 /// # Errors
-/// The first failing realization's error, in realization order.
+/// [`SamplerError::Memory`] before anything is drawn when the sets would
+/// not fit in memory; else the first failing realization's error, in
+/// realization order.
 pub fn generate_sets(
     sampler: &dyn Sampler,
     seed: u64,
     sets: usize,
     on_set_done: &(dyn Fn() + Sync),
 ) -> Result<Vec<PointSet>, SamplerError> {
+    let per_set = sampler.points_per_set() as f64 * sampler.dim() as f64 * 8.0 + 64.0;
+    crate::memory::check(
+        &format!(
+            "{sets} realizations of {} points in {}D",
+            sampler.points_per_set(),
+            sampler.dim()
+        ),
+        Some(sets as f64 * per_set),
+        "lower --sets",
+    )?;
     (0..sets as u64)
         .into_par_iter()
         .map(|r| {

@@ -77,6 +77,12 @@ pub fn pair_correlation(
             s.dim()
         ));
     }
+    // Radii, the profile and one accumulator per set in flight.
+    crate::memory::check(
+        &format!("a pair correlation of {bins} bins"),
+        Some(bins as f64 * 8.0 * (3.0 + rayon::current_num_threads() as f64)),
+        "lower --bins",
+    )?;
     let r: Vec<f64> = (1..=bins).map(|b| r_end * b as f64 / bins as f64).collect();
     let step = r_end / bins as f64;
     let reach = r_end + 6.0 * bandwidth;

@@ -24,6 +24,23 @@ pub struct SquareMse {
     pub per_set: Vec<f64>,
 }
 
+/// Refuses a family MSE of `sets` sets over `members` members that would
+/// not fit in memory ([`family_mse`] keeps every member's squared error of
+/// every set: 8 bytes each, and 32 per member).
+///
+/// # Errors
+/// [`TooMuchMemory`](crate::memory::TooMuchMemory) with the estimate.
+pub fn check_family_memory(
+    members: usize,
+    sets: usize,
+) -> Result<(), crate::memory::TooMuchMemory> {
+    crate::memory::check(
+        &format!("the squared errors of {sets} sets on {members} family members"),
+        Some(members as f64 * (sets as f64 * 8.0 + 32.0)),
+        "lower --members",
+    )
+}
+
 /// The family MSE of `sets` over `members` members drawn with `seed`.
 ///
 /// # Panics

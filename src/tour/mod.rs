@@ -302,10 +302,7 @@ pub struct Tour {
 }
 
 fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Result<Vec<PointSet>, TourError> {
-    (0..sets as u64)
-        .map(|r| sampler.sample(&mut set_rng(seed, r)))
-        .collect::<Result<_, _>>()
-        .map_err(at("drawing sets"))
+    crate::samplers::generate_sets(sampler, seed, sets, &|| {}).map_err(at("drawing sets"))
 }
 
 /// Runs the tour, writing its pictures into `options.folder`;

@@ -40,3 +40,4 @@ pub fn assert_fails(args: &[&str], phrase: &str) {
     assert!(!err.contains("panicked"), "{args:?}: {err}");
 }
 pub mod fuzz;
+pub mod hostile;
