@@ -37,6 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         step: 0.05,
         final_step: 0.002,
         score_every: 1,
+        floor: 0.0,
     };
     let sets = 8u64;
     let clock = std::time::Instant::now();

@@ -30,6 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         step,
         final_step: step / 25.0,
         score_every: 20,
+        floor: 0.0,
     };
     let start = std::time::Instant::now();
     let mut before = Vec::new();

@@ -95,6 +95,7 @@ fn a_designed_set_beats_sheared_umj_and_stays_blue() {
         step: 0.05,
         final_step: 0.002,
         score_every: 1,
+        floor: 0.0,
     };
     let designed: Vec<PointSet> = (0..4)
         .map(|r| {

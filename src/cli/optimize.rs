@@ -152,6 +152,13 @@ enum DomainArg {
     Square,
 }
 
+/// Bytes of the designed sets kept until all are written: each set's
+/// points and its loss curve (loss and time per iteration, at most 2000).
+fn results_bytes(a: &PointsArgs) -> f64 {
+    let iters = a.iters.unwrap_or(2000) as f64;
+    a.sets as f64 * (a.n as f64 * a.dim as f64 * 8.0 + iters * 16.0)
+}
+
 fn points(a: PointsArgs) -> anyhow::Result<()> {
     args::check_outputs([
         Some(a.output.as_path()),
@@ -162,6 +169,11 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     if a.sets == 0 {
         bail!("--sets must be at least 1");
     }
+    varspec::memory::check(
+        &format!("the results of {} designed sets of {} points", a.sets, a.n),
+        Some(results_bytes(&a)),
+        "lower --sets",
+    )?;
     if !(a.checkpoint_every >= 0.0 && a.checkpoint_every.is_finite()) {
         bail!(
             "--checkpoint-every {}: give a number of seconds >= 0",
@@ -256,12 +268,16 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         (registry::build(&init_name, a.n, Some(a.dim), &[])?, None)
     };
     let plan_bytes = nufft_memory_bytes(optimizer.frequencies()).unwrap_or(f64::INFINITY);
-    let memory =
-        plan_bytes + rayon::current_num_threads().min(a.sets) as f64 * optimizer.descent_bytes(a.n);
+    let memory = plan_bytes
+        + rayon::current_num_threads().min(a.sets) as f64 * optimizer.descent_bytes(a.n)
+        + results_bytes(&a);
     varspec::memory::check(
-        &format!("the descent of {} points on a box |k| <= {half}", a.n),
+        &format!(
+            "{} descent(s) of {} points on a box |k| <= {half}",
+            a.sets, a.n
+        ),
         Some(memory),
-        "lower -n or --res",
+        "lower --sets, -n or --res",
     )?;
     println!(
         "memory: about {:.0} MiB (box |k| <= {half}: {} frequencies; {} set(s) at a time)",
@@ -486,6 +502,7 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
         step: 0.05,
         final_step: 0.002,
         score_every: 1,
+        floor: 0.0,
     };
     let bar = progress::bar((a.sets * options.iters) as u64, "optimizing");
     let start = Instant::now();
@@ -559,6 +576,8 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
         bail!("the square holds 2D point sets (got -d {})", a.dim);
     }
     let terms = parse_target(&a.target)?;
+    // Scores: the designed sets and 8 or more sets of each classic sampler.
+    varspec::square::mse::check_family_memory(a.members, a.sets.max(8))?;
     let mut options = default_options();
     if let Some(i) = a.iters {
         options.iters = i;
@@ -704,6 +723,18 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         );
     }
     let sampler = registry::build(&a.sampler, a.n, Some(4), &[])?;
+    // The written sets, drawn and sheared (two copies), and a few numbers
+    // per realization of the check.
+    let bytes = 2.0 * a.sets as f64 * sampler.points_per_set() as f64 * 4.0 * 8.0
+        + a.realizations as f64 * 64.0;
+    varspec::memory::check(
+        &format!(
+            "{} written sets and {} check realizations",
+            a.sets, a.realizations
+        ),
+        Some(bytes),
+        "lower --sets or --realizations",
+    )?;
     let start = Instant::now();
     let spectral = spectral_start(f.as_ref(), 64, a.range);
     let mut starts = spectral.candidates();

@@ -11,7 +11,8 @@
 //! so the steps after a recovery are the cautious first steps of a fresh
 //! Adam, not large ones) and halves the rate. The descent stops when the
 //! score improves by less than a relative `rel_tol` over 50 scored
-//! iterations (0 disables the test), or after `iters`.
+//! iterations (0 disables the test), once it reaches the objective's
+//! accuracy floor, or after `iters`.
 
 use crate::points::{PointSet, wrap01};
 use crate::rng::PREV_ONE;
@@ -62,6 +63,9 @@ pub struct AdamOptions {
     pub final_step: f64,
     /// Score a stochastic objective every this many iterations.
     pub score_every: usize,
+    /// Stop once the score is at or below this (0: never): the level below
+    /// which the objective cannot resolve a loss from zero.
+    pub floor: f64,
 }
 
 /// The optimized set and how it got there.
@@ -234,6 +238,9 @@ pub fn adam_from(
                 continue;
             }
             let k = s.scores.len();
+            if score <= o.floor {
+                break;
+            }
             if o.rel_tol > 0.0 && k > 50 && s.scores[k - 51] - score < o.rel_tol * score {
                 break;
             }

@@ -165,6 +165,14 @@ impl PointOptimizer {
         len * 40.0 + n as f64 * (16.0 + 8.0 * 8.0 * self.freqs.dim as f64)
     }
 
+    /// The loss a set with P_S = 0 in the box shows through transforms of
+    /// tolerance ε: each S(k) is off by at most ε·Σ_j|c_j| = ε·N, so the
+    /// computed loss is at most ε²·ΣW there. Below this level the loss
+    /// cannot be told from zero and the descent stops (converged).
+    pub fn loss_floor(&self) -> f64 {
+        self.options.tolerance * self.options.tolerance * crate::sum::sum(self.weights.iter().copied())
+    }
+
     /// The weights W(k) in box order.
     pub fn weights(&self) -> &[f64] {
         &self.weights
@@ -267,6 +275,7 @@ impl PointOptimizer {
             step: o.step,
             final_step: o.final_step,
             score_every: 1,
+            floor: self.loss_floor(),
         };
         let objective = TorusObjective {
             optimizer: self,

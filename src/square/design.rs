@@ -235,6 +235,7 @@ pub fn default_options() -> AdamOptions {
         step: 0.1,
         final_step: 0.004,
         score_every: 20,
+        floor: 0.0,
     }
 }
 
