@@ -12,6 +12,8 @@ use serde_json::json;
 use super::{args, progress};
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
 use varspec::optimize::adapted::{CheckpointEvent, CheckpointPlan, Kept, design_sets};
+use varspec::optimize::baseline::classic_baselines;
+use varspec::samplers::SamplerError;
 use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::registry;
@@ -362,17 +364,12 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         "optimized".into(),
         json!({"n": a.n, "loss": mean(&final_losses)}),
     );
-    for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
-        if let Ok((s, n)) = registry::build_nearest(name, a.n, Some(a.dim), &[]) {
-            let losses: Vec<f64> = (0..a.sets.max(8) as u64)
-                .into_par_iter()
-                .map(|r| {
-                    s.sample(&mut set_rng(a.seed ^ 0x5eed, r))
-                        .map(|p| optimizer.loss(&p))
-                })
-                .collect::<Result<_, _>>()?;
-            comparison.insert(name.into(), json!({"n": n, "loss": mean(&losses)}));
-        }
+    let baselines = classic_baselines(a.n, a.dim, a.sets.max(8), a.seed, |sets| {
+        let losses: Vec<f64> = sets.par_iter().map(|p| optimizer.loss(p)).collect();
+        Ok::<_, SamplerError>(mean(&losses))
+    })?;
+    for b in &baselines {
+        comparison.insert(b.name.into(), json!({"n": b.n, "loss": b.score}));
     }
     let iterations: Vec<usize> = results.iter().map(|r| r.descent.losses.len()).collect();
     // The exact variance (spatial form, no box) beside the in-box loss, for
@@ -451,14 +448,12 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
             points: curve.clone(),
             reference: false,
         }];
-        for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
-            if let Some(l) = comparison.get(name).and_then(|v| v["loss"].as_f64()) {
-                series.push(Series {
-                    label: name.into(),
-                    points: vec![(t0, l), (t1, l)],
-                    reference: true,
-                });
-            }
+        for b in &baselines {
+            series.push(Series {
+                label: b.name.into(),
+                points: vec![(t0, b.score), (t1, b.score)],
+                reference: true,
+            });
         }
         let plot = LinePlot {
             title: format!("loss against time: {} N={}", a.target, a.n),
@@ -632,15 +627,12 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     };
     let mut comparison = serde_json::Map::new();
     comparison.insert("optimized".into(), json!(score(&sets)));
-    for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
-        if let Ok((s, n)) = registry::build_nearest(name, a.n, Some(2), &[]) {
-            let classic: Vec<_> = (0..a.sets.max(8) as u64)
-                .map(|r| s.sample(&mut set_rng(a.seed ^ 0x5eed, r)))
-                .collect::<Result<_, _>>()?;
-            let mut m = score(&classic);
-            m.insert("n".into(), json!(n));
-            comparison.insert(name.into(), json!(m));
-        }
+    for b in classic_baselines(a.n, 2, a.sets.max(8), a.seed, |sets| {
+        Ok::<_, SamplerError>(score(sets))
+    })? {
+        let mut m = b.score;
+        m.insert("n".into(), json!(b.n));
+        comparison.insert(b.name.into(), json!(m));
     }
     println!(
         "{} set(s) of {} points designed on the square for {} in {seconds:.2} s (from {init_name}); \
