@@ -49,6 +49,7 @@ pub mod source;
 pub mod spectrum;
 pub mod square;
 pub mod sum;
+pub mod tables;
 pub mod tour;
 pub mod variance;
 

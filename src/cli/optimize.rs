@@ -13,12 +13,12 @@ use super::{args, progress};
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
 use varspec::optimize::adapted::{CheckpointEvent, CheckpointPlan, Kept, design_sets};
 use varspec::optimize::baseline::classic_baselines;
-use varspec::samplers::SamplerError;
 use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::samplers;
+use varspec::samplers::SamplerError;
 use varspec::spectrum::nufft::nufft_memory_bytes;
 
 #[derive(Subcommand)]

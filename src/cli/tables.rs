@@ -7,13 +7,14 @@ use clap::ValueEnum;
 
 use super::args::DrawArgs;
 use super::progress;
-use varspec::integrands;
 use varspec::io::read_point_sets;
-use varspec::io::tables::{TableFormat, TableMetadata, write_table};
+use varspec::io::tables::{TableFormat, write_table};
 use varspec::io::write_atomic;
 use varspec::registry;
 use varspec::samplers;
-use varspec::variance::spatial_variance;
+use varspec::tables::{
+    PredictedVariances, Provenance, REFERENCE_INTEGRANDS, metadata, optimized_for,
+};
 
 #[derive(Clone, Copy, ValueEnum)]
 enum FormatArg {
@@ -23,14 +24,6 @@ enum FormatArg {
     F64,
     CHeader,
 }
-
-/// Reference integrands whose predicted variance goes into the metadata.
-const REFERENCE: [&str; 4] = [
-    "disk:r=0.3",
-    "box:w=0.5,h=0.25,angle=30",
-    "gaussian:sx=0.1,sy=0.05,angle=20",
-    "halfplane:angle=17,offset=0.07",
-];
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -61,10 +54,6 @@ pub struct Args {
     variance: bool,
 }
 
-/// Pair evaluations (reference integrands × N² × sets) the predicted
-/// variances of the metadata may cost without `--variance` (~10 s here).
-const VARIANCE_BUDGET: u128 = 1 << 28;
-
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs([Some(a.output.as_path())])?;
     let (sets, source) = match (&a.sampler, &a.from) {
@@ -92,50 +81,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         (None, None) => bail!("give --sampler or --from"),
     };
-    let optimized_for = match &a.sampler {
-        None => "unknown".to_string(),
-        Some(spec) => {
-            let (name, params) = registry::split_spec(spec, &a.draw.params)?;
-            if registry::find(name)?.name == "blue-noise" {
-                params
-                    .iter()
-                    .rev()
-                    .find(|(k, _)| k == "domain")
-                    .map_or_else(|| "torus".to_string(), |(_, v)| v.clone())
-            } else {
-                "none".to_string()
-            }
-        }
-    };
-    let (n, dim) = (sets[0].len(), sets[0].dim());
-    if sets.iter().any(|s| s.len() != n) {
-        bail!("{source}: a table needs every set to have the same N");
-    }
-    let pairs = REFERENCE.len() as u128 * (n as u128).pow(2) * sets.len() as u128;
-    let affordable = a.variance || pairs <= VARIANCE_BUDGET;
-    if dim == 2 && !affordable {
-        eprintln!(
-            "predicted variances left out of the metadata: {pairs:.3e} pair evaluations \
-             ({} integrands x N^2 x {} sets) exceed 2^28; pass --variance to compute them",
-            REFERENCE.len(),
-            sets.len()
-        );
-    }
-    let predicted_variance = if dim == 2 && affordable {
-        REFERENCE
-            .iter()
-            .map(|spec| -> anyhow::Result<(String, f64)> {
-                let f = integrands::parse(spec)?;
-                let mut total = 0.0;
-                for s in &sets {
-                    total += spatial_variance(s, f.as_ref())?.0;
-                }
-                Ok((f.spec(), total / sets.len() as f64))
-            })
-            .collect::<anyhow::Result<_>>()?
-    } else {
-        Vec::new()
-    };
     let format = match a.format {
         FormatArg::Csv => TableFormat::Csv,
         FormatArg::Json => TableFormat::Json,
@@ -143,22 +88,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         FormatArg::F64 => TableFormat::F64,
         FormatArg::CHeader => TableFormat::CHeader,
     };
-    let value_type = match format {
-        TableFormat::F32 | TableFormat::CHeader => "f32 (float), little-endian where raw",
-        _ => "f64",
-    };
-    let meta = TableMetadata {
-        generator: format!("varspec {}", env!("CARGO_PKG_VERSION")),
+    let provenance = Provenance {
+        optimized_for: optimized_for(a.sampler.as_deref(), &a.draw.params)?,
         source,
         params: a.draw.params.clone(),
         seed: a.draw.seed,
-        n,
-        dim,
-        sets: sets.len(),
-        layout: format!("[set][point][dimension], {value_type}, values in [0, 1)"),
-        optimized_for,
-        predicted_variance,
     };
+    let (meta, predicted) = metadata(&sets, provenance, format, a.variance)?;
+    if let PredictedVariances::OverBudget { pairs } = predicted {
+        eprintln!(
+            "predicted variances left out of the metadata: {pairs:.3e} pair evaluations \
+             ({} integrands x N^2 x {} sets) exceed 2^28; pass --variance to compute them",
+            REFERENCE_INTEGRANDS.len(),
+            sets.len()
+        );
+    }
     let name = a
         .output
         .file_stem()
@@ -177,9 +121,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         })?;
     }
     println!(
-        "wrote {} ({} sets of {n} points in {dim}D)",
+        "wrote {} ({} sets of {} points in {}D)",
         a.output.display(),
-        sets.len()
+        sets.len(),
+        meta.n,
+        meta.dim
     );
     Ok(())
 }

@@ -170,7 +170,9 @@ impl PointOptimizer {
     /// computed loss is at most ε²·ΣW there. Below this level the loss
     /// cannot be told from zero and the descent stops (converged).
     pub fn loss_floor(&self) -> f64 {
-        self.options.tolerance * self.options.tolerance * crate::sum::sum(self.weights.iter().copied())
+        self.options.tolerance
+            * self.options.tolerance
+            * crate::sum::sum(self.weights.iter().copied())
     }
 
     /// The weights W(k) in box order.
