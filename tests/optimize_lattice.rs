@@ -68,6 +68,7 @@ fn the_lower_exact_variance_is_kept() {
         seconds: vec![0.0, 0.1],
         best_score: 0.5,
         start_score: 1.0,
+        coarse_iterations: 0,
     };
     let kept = keep_lower_variance(good.clone(), result(&bad), f.as_ref()).unwrap();
     let e = kept.exact.unwrap();

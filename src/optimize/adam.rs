@@ -81,6 +81,9 @@ pub struct DescentResult {
     pub best_score: f64,
     /// The start's score.
     pub start_score: f64,
+    /// Iterations of a coarse first phase run before `losses` began (0:
+    /// none; see [`super::descent::DescentOptions::coarse_half`]).
+    pub coarse_iterations: usize,
 }
 
 /// Everything the descent needs to go on from iteration `t`: positions,
@@ -116,6 +119,8 @@ pub struct AdamState {
     /// Wall time at every entry of `losses`, in seconds since the run began
     /// (across restarts).
     pub seconds: Vec<f64>,
+    /// Wall time spent before the first entry (a coarse phase), in seconds.
+    pub seconds_offset: f64,
 }
 
 impl AdamState {
@@ -137,6 +142,7 @@ impl AdamState {
             scores: Vec::new(),
             losses: Vec::new(),
             seconds: Vec::new(),
+            seconds_offset: 0.0,
         }
     }
 
@@ -194,7 +200,7 @@ pub fn adam_from(
     let spacing = (1.0 / n.max(1) as f64).powf(1.0 / d as f64);
     let (beta1, beta2, eps) = (0.9f64, 0.999f64, 1e-300f64);
     let mut grad = vec![0.0; n * d];
-    let offset = s.seconds.last().copied().unwrap_or(0.0);
+    let offset = s.seconds.last().copied().unwrap_or(s.seconds_offset);
     let clock = std::time::Instant::now();
     let mut last_save = clock;
     while s.t < o.iters {
@@ -276,5 +282,6 @@ pub fn adam_from(
         seconds: s.seconds,
         best_score: s.best_score,
         start_score: s.start_score,
+        coarse_iterations: 0,
     }
 }

@@ -184,5 +184,6 @@ pub fn load(path: &Path, run: &str) -> Result<Option<AdamState>, CheckpointError
         scores,
         losses,
         seconds,
+        seconds_offset: 0.0,
     }))
 }
