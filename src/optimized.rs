@@ -29,7 +29,7 @@ pub struct Optimized {
 enum How {
     Torus {
         start: Random,
-        optimizer: PointOptimizer,
+        optimizer: Box<PointOptimizer>,
     },
     Square {
         start: Box<dyn Sampler>,
@@ -63,7 +63,7 @@ pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> 
                 .map_err(|e| c.bad_param("target", e.to_string()))?;
             How::Torus {
                 start: Random::new(c.n, c.dim),
-                optimizer,
+                optimizer: Box::new(optimizer),
             }
         }
         "square" => {
