@@ -29,6 +29,7 @@
 //! assert!(exact < 0.3 * disk.variance() / 256.0);
 //! ```
 
+pub mod baseline;
 pub mod error;
 pub mod experiment;
 pub mod integrands;

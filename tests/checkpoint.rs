@@ -7,7 +7,7 @@ mod common;
 
 use std::process::Command;
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use varspec::optimize::adam::AdamState;
 use varspec::optimize::checkpoint::{self, CheckpointError};
@@ -164,20 +164,7 @@ fn a_killed_descent_continues_from_its_checkpoint_to_the_same_set() {
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
-    let clock = Instant::now();
-    let mut saved = false;
-    while clock.elapsed() < Duration::from_secs(120) {
-        if ckpt.exists() {
-            saved = true;
-            break;
-        }
-        if child.try_wait().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    child.kill().unwrap(); // SIGKILL on Unix
-    let status = child.wait().unwrap();
+    let (saved, status) = common::kill_when(&mut child, Duration::from_secs(120), || ckpt.exists());
     assert!(
         saved,
         "no checkpoint appeared before the run ended: nothing was tested"

@@ -5,7 +5,7 @@
 mod common;
 
 use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 fn temporaries(dir: &std::path::Path) -> Vec<String> {
     std::fs::read_dir(dir)
@@ -36,23 +36,11 @@ fn a_killed_write_leaves_the_old_file_whole_and_no_temporary_behind() {
         .arg(&target)
         .spawn()
         .unwrap();
-    let start = Instant::now();
-    let mut caught = false;
-    while start.elapsed() < Duration::from_secs(60) {
-        let writing = temporaries(&dir)
+    let (caught, _) = common::kill_when(&mut child, Duration::from_secs(60), || {
+        temporaries(&dir)
             .iter()
-            .any(|name| std::fs::metadata(dir.join(name)).is_ok_and(|m| m.len() > 1 << 20));
-        if writing {
-            caught = true;
-            break;
-        }
-        if child.try_wait().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    child.kill().unwrap(); // SIGKILL on Unix
-    child.wait().unwrap();
+            .any(|name| std::fs::metadata(dir.join(name)).is_ok_and(|m| m.len() > 1 << 20))
+    });
     assert!(
         caught,
         "the write finished before it could be killed: nothing was tested"

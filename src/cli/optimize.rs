@@ -10,9 +10,9 @@ use rayon::prelude::*;
 use serde_json::json;
 
 use super::{args, progress};
+use varspec::baseline::classic_baselines;
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
 use varspec::optimize::adapted::{CheckpointEvent, CheckpointPlan, Kept, design_sets};
-use varspec::optimize::baseline::classic_baselines;
 use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::registry;

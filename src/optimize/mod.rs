@@ -4,7 +4,6 @@
 
 pub mod adam;
 pub mod adapted;
-pub mod baseline;
 pub mod checkpoint;
 pub mod descent;
 pub mod lattice;

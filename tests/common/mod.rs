@@ -20,6 +20,30 @@ pub fn varspec_with(args: &[&str], threads: Option<&str>) -> Output {
     cmd.output().expect("the varspec binary runs")
 }
 
+/// Kills `child` with SIGKILL as soon as `ready()` holds (polled every
+/// 2 ms, for at most `limit`); returns whether it held before the child
+/// ended on its own, and the child's exit status.
+pub fn kill_when(
+    child: &mut std::process::Child,
+    limit: std::time::Duration,
+    ready: impl Fn() -> bool,
+) -> (bool, std::process::ExitStatus) {
+    let clock = std::time::Instant::now();
+    let mut held = false;
+    while clock.elapsed() < limit {
+        if ready() {
+            held = true;
+            break;
+        }
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap(); // SIGKILL on Unix
+    (held, child.wait().unwrap())
+}
+
 /// A fresh folder for one test's files.
 pub fn temp_dir(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("varspec-{tag}-{}", std::process::id()));
