@@ -12,7 +12,9 @@ use serde_json::json;
 use super::{args, progress};
 use varspec::baseline::classic_baselines;
 use varspec::io::{PointFormat, write_atomic, write_point_sets};
-use varspec::optimize::adapted::{CheckpointEvent, CheckpointPlan, Kept, design_sets};
+use varspec::optimize::adapted::{
+    CheckpointEvent, CheckpointPlan, Kept, checkpoint_path, design_sets, remove_checkpoints,
+};
 use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::registry;
@@ -201,9 +203,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     }
     if let Some(path) = &a.checkpoint {
         for r in 0..a.sets {
-            varspec::io::check_output(&varspec::optimize::adapted::checkpoint_path(
-                path, r, a.sets,
-            ))?;
+            varspec::io::check_output(&checkpoint_path(path, r, a.sets))?;
         }
     }
     if a.domain == DomainArg::Square {
@@ -252,8 +252,10 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         }
         options.coarse_half = Some(options.half / 4);
     }
+    let coarse_half = options.coarse_half;
     let half = options.half;
     let options_tolerance = options.tolerance;
+    let options_rel_tol = options.rel_tol;
     let optimizer = PointOptimizer::new(a.dim, &target, options)?;
     let start = Instant::now();
     let (init, lattice): (Box<dyn samplers::Sampler>, _) = if init_name == "lattice" {
@@ -311,14 +313,12 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     );
     let bar = progress::bar((a.sets * iters) as u64, "optimizing");
     let run = format!(
-        "optimize points -n {} -d {} --target {} --init {init_name} --seed {} --iters {iters} --res {} --tol {options_tolerance:e} --rel-tol {:e} --coarse {}",
+        "optimize points -n {} -d {} --target {} --init {init_name} --seed {} --iters {iters} --res {} --tol {options_tolerance:e} --rel-tol {options_rel_tol:e} --coarse {}",
         a.n,
         a.dim,
         a.target,
         a.seed,
         2 * half + 1,
-        a.rel_tol
-            .unwrap_or(DescentOptions::for_target(a.n, a.dim, &target).rel_tol),
         a.coarse,
     );
     let on_event = |event: CheckpointEvent| match event {
@@ -362,13 +362,8 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     let sets: Vec<_> = results.iter().map(|r| r.points.clone()).collect();
     write_atomic(&a.output, |w| write_point_sets(w, &sets, PointFormat::Csv))?;
     if let Some(path) = &a.checkpoint {
-        for r in 0..a.sets {
-            let file = varspec::optimize::adapted::checkpoint_path(path, r, a.sets);
-            match std::fs::remove_file(&file) {
-                Ok(()) => {}
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(e) => eprintln!("warning: checkpoint {} not removed: {e}", file.display()),
-            }
+        for (file, e) in remove_checkpoints(path, a.sets) {
+            eprintln!("warning: checkpoint {} not removed: {e}", file.display());
         }
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
@@ -399,9 +394,9 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     // integrand targets that have a closed-form autocovariance.
     let exact: Option<Vec<f64>> = results.iter().map(Kept::variance).collect();
     let kept_start = results.iter().filter(|r| r.start_returned()).count();
-    let coarse = match results[0].descent.coarse_iterations {
-        0 => String::new(),
-        c => format!("{c} on the box |k| <= {} then ", half / 4),
+    let coarse = match (results[0].descent.coarse_iterations, coarse_half) {
+        (c, Some(h)) if c > 0 => format!("{c} on the box |k| <= {h} then "),
+        _ => String::new(),
     };
     println!(
         "{} set(s) of {} points for {} in {seconds:.2} s ({coarse}{} iterations for set 0); loss {:.4e}",

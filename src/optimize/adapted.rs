@@ -175,6 +175,19 @@ pub fn checkpoint_path(path: &Path, set: usize, sets: usize) -> PathBuf {
     PathBuf::from(name)
 }
 
+/// Removes the checkpoint files of `sets` sets with base path `path` (once
+/// the designs are written); returns those that could not be removed, with
+/// why. Files already gone are not failures.
+pub fn remove_checkpoints(path: &Path, sets: usize) -> Vec<(PathBuf, std::io::Error)> {
+    (0..sets)
+        .map(|r| checkpoint_path(path, r, sets))
+        .filter_map(|file| match std::fs::remove_file(&file) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Some((file, e)),
+            _ => None,
+        })
+        .collect()
+}
+
 /// `sets` designs: realization r of `start` (stream (seed, r)) descended by
 /// `optimizer`, each kept by [`keep_lower_variance`] when `exact` is given.
 /// Sets run in parallel; each is independent of the thread count. With a
