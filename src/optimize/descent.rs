@@ -191,10 +191,15 @@ impl PointOptimizer {
     /// grids ([`crate::spectrum::nufft::nufft_memory_bytes`]): spectrum,
     /// coefficients and weights on the box, values at the points, and
     /// Adam's positions, moments, best set and gradient (eight copies of
-    /// N·d coordinates with the point sets built from them).
+    /// N·d coordinates with the point sets built from them), and the
+    /// transform's per-point scratch
+    /// ([`crate::spectrum::nufft::nufft_point_bytes`]).
     pub fn descent_bytes(&self, n: usize) -> f64 {
         let len = self.freqs.len() as f64;
-        len * 40.0 + n as f64 * (16.0 + 8.0 * 8.0 * self.freqs.dim as f64)
+        let d = self.freqs.dim;
+        len * 40.0
+            + n as f64
+                * (16.0 + 8.0 * 8.0 * d as f64 + crate::spectrum::nufft::nufft_point_bytes(d))
     }
 
     /// The loss a set with P_S = 0 in the box shows through transforms of

@@ -27,6 +27,78 @@ use rustfft::{Fft, FftDirection, FftPlanner};
 use super::{FrequencyBox, SpectrumError};
 use crate::points::PointSet;
 
+/// Evaluates `$body` with the kernel width `$width` (2..=16) as the
+/// constant `$w`, so that the per-point kernel loops have fixed lengths
+/// the compiler unrolls and vectorises (one copy per width, as FINUFFT
+/// templates its spreaders on the width).
+macro_rules! with_width {
+    ($width:expr, $w:ident => $body:expr) => {
+        match $width {
+            2 => {
+                const $w: usize = 2;
+                $body
+            }
+            3 => {
+                const $w: usize = 3;
+                $body
+            }
+            4 => {
+                const $w: usize = 4;
+                $body
+            }
+            5 => {
+                const $w: usize = 5;
+                $body
+            }
+            6 => {
+                const $w: usize = 6;
+                $body
+            }
+            7 => {
+                const $w: usize = 7;
+                $body
+            }
+            8 => {
+                const $w: usize = 8;
+                $body
+            }
+            9 => {
+                const $w: usize = 9;
+                $body
+            }
+            10 => {
+                const $w: usize = 10;
+                $body
+            }
+            11 => {
+                const $w: usize = 11;
+                $body
+            }
+            12 => {
+                const $w: usize = 12;
+                $body
+            }
+            13 => {
+                const $w: usize = 13;
+                $body
+            }
+            14 => {
+                const $w: usize = 14;
+                $body
+            }
+            15 => {
+                const $w: usize = 15;
+                $body
+            }
+            16 => {
+                const $w: usize = 16;
+                $body
+            }
+            other => unreachable!("kernel widths are 2..=16 (kernel_shape), not {other}"),
+        }
+    };
+}
+
 /// The sign of the exponent: e^(−2πi k·x) (`Negative`, the sample spectrum's)
 /// or e^(+2πi k·x).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -61,10 +133,15 @@ pub struct NufftPlan {
 pub struct NufftScratch {
     grid: Vec<Complex64>,
     swap: Vec<Complex64>,
-    /// Point indices in bin order, and the bins' counts.
-    order: (Vec<usize>, Vec<usize>),
-    /// One grid slab per row group (see [`NufftPlan::spread`]).
-    slabs: Vec<Vec<Complex64>>,
+    /// Point indices in bin order.
+    order: BinOrder,
+    /// The points' coordinates (and strengths) in bin order: gathered
+    /// once, in parallel, so the spreading and interpolation read them in
+    /// sequence (read through `order` they were a cache miss per point, 40%
+    /// of the spreading's time at a million points).
+    sorted: (Vec<f64>, Vec<Complex64>),
+    /// One real slab per row group (see [`NufftPlan::spread`]).
+    slabs: Vec<Vec<f64>>,
 }
 
 impl NufftPlan {
@@ -140,7 +217,8 @@ impl NufftPlan {
         NufftScratch {
             grid: vec![zero; cells],
             swap: vec![zero; cells],
-            order: (Vec::new(), Vec::new()),
+            order: BinOrder::default(),
+            sorted: (Vec::new(), Vec::new()),
             slabs: Vec::new(),
         }
     }
@@ -200,19 +278,21 @@ impl NufftPlan {
         // Interpolation only reads the grid: points in bin order, in
         // parallel chunks, each value computed on its own.
         self.bin_order(points, &mut scratch.order);
-        let (order, grid) = (&scratch.order.0, &scratch.grid);
-        let values: Vec<Complex64> = order
-            .par_chunks(POINTS_PER_TASK)
+        gather_sorted(points, None, &scratch.order.order, &mut scratch.sorted);
+        let (order, grid, coords) = (&scratch.order.order, &scratch.grid, &scratch.sorted.0);
+        let d = self.freqs.dim;
+        let values: Vec<Complex64> = with_width!(self.width, W => coords
+            .par_chunks(POINTS_PER_TASK * d)
             .flat_map_iter(|chunk| {
-                chunk.iter().map(|&j| {
+                chunk.chunks_exact(d).map(|x| {
                     let mut acc = Complex64::new(0.0, 0.0);
-                    self.for_each_grid_neighbour(points.point(j), None, |cell, weight| {
+                    self.for_each_grid_neighbour::<W>(x, |cell, weight| {
                         acc += grid[cell] * weight
                     });
                     acc
                 })
             })
-            .collect();
+            .collect());
         for (&j, v) in order.iter().zip(values) {
             out[j] = v;
         }
@@ -249,84 +329,218 @@ impl NufftPlan {
     /// Spreads the points (strength 1 or `strengths`) onto `scratch.grid`.
     ///
     /// Points are taken in bin order and split into groups of G rows of the
-    /// last axis (G ≥ the kernel width, a multiple of the bin height); each
-    /// group spreads into its own slab of G + 2⌈w/2⌉ rows in parallel, and
-    /// each grid row then adds the slabs that cover it in group order. The
+    /// last axis (G ≥ the kernel width, a multiple of the bin height; one
+    /// group of all n rows when the grid is too small for two); each group
+    /// spreads into its own slab in parallel, and each grid row then adds
+    /// the slab rows that fall on it, slab by slab in group order. The
     /// groups depend on the grid and the kernel alone, so the sums, and the
     /// result, are identical for any thread count.
+    ///
+    /// A slab is real (f64), not complex: one value per cell without
+    /// strengths (the sample spectrum's case, half the memory traffic), two
+    /// with. Its first axis is padded by the kernel's reach on both sides
+    /// instead of wrapping, so each kernel row is one contiguous multiply-add
+    /// of w (or 2w) values, which the compiler vectorises; the padding is
+    /// folded back onto the periodic grid in the reduction.
     fn spread(
         &self,
         points: &PointSet,
         strengths: Option<&[Complex64]>,
         scratch: &mut NufftScratch,
     ) {
-        let (n, d, w) = (self.grid, self.freqs.dim, self.width);
-        let one = Complex64::new(1.0, 0.0);
-        let zero = Complex64::new(0.0, 0.0);
+        let (n, d) = (self.grid, self.freqs.dim);
+        let layout = SlabLayout::new(n, d, self.width, strengths.is_some());
         self.bin_order(points, &mut scratch.order);
-        let order = &scratch.order.0;
-        let bin = BIN[d - 1];
-        let rows = w.div_ceil(bin).max(1) * bin;
-        let margin = w.div_ceil(2);
-        let height = rows + 2 * margin;
-        let groups = n.div_ceil(rows);
-        let row_len = n.pow(d as u32 - 1);
-        // Points `indices` onto `target`, whose last axis starts at row
-        // `origin` (a slab) or wraps (the whole grid).
-        let spread_into = |target: &mut [Complex64], indices: &[usize], origin: Option<i64>| {
-            for &j in indices {
-                let c = strengths.map_or(one, |s| s[j]);
-                self.for_each_grid_neighbour(points.point(j), origin, |cell, weight| {
-                    target[cell] += c * weight
-                });
-            }
-        };
-        if groups < 2 || height > n {
-            // One group: spread straight into the (periodic) grid.
-            scratch.grid.fill(zero);
-            spread_into(&mut scratch.grid, order, None);
-            return;
-        }
+        let order = &scratch.order.order;
         // The group of a point: its last coordinate's row over `rows`; bin
         // order sorts the last axis slowest, so groups are contiguous.
         let group_of = |j: usize| {
             let t = points.point(j)[d - 1] * n as f64;
-            ((t as usize) / rows).min(groups - 1)
+            ((t as usize) / layout.rows).min(layout.groups - 1)
         };
-        let starts: Vec<usize> = (0..=groups)
+        let starts: Vec<usize> = (0..=layout.groups)
             .map(|g| order.partition_point(|&j| group_of(j) < g))
             .collect();
-        scratch.slabs.resize_with(groups, Vec::new);
+        gather_sorted(points, strengths, order, &mut scratch.sorted);
+        let (coords, sorted_strengths) = (&scratch.sorted.0, &scratch.sorted.1);
+        scratch.slabs.resize_with(layout.groups, Vec::new);
+        scratch.slabs.truncate(layout.groups);
         scratch
             .slabs
             .par_iter_mut()
             .enumerate()
             .for_each(|(g, slab)| {
                 slab.clear();
-                slab.resize(height * row_len, zero);
-                let origin = (g * rows) as i64 - margin as i64;
-                spread_into(slab, &order[starts[g]..starts[g + 1]], Some(origin));
+                slab.resize(layout.height * layout.row_len, 0.0);
+                let (range, origin) = (starts[g]..starts[g + 1], layout.origin(g));
+                let x = &coords[range.start * d..range.end * d];
+                with_width!(self.width, W => match strengths {
+                    None => self.spread_slab_fastest::<W, 1>(x, None, &layout, origin, slab),
+                    Some(_) => {
+                        let c = &sorted_strengths[range];
+                        self.spread_slab_fastest::<W, 2>(x, Some(c), &layout, origin, slab)
+                    }
+                });
             });
         let slabs = &scratch.slabs;
+        let grid_row = n.pow(d as u32 - 1);
+        let (line_in, line_out, pad) = if d == 1 {
+            (1, 1, 0)
+        } else {
+            (layout.line, n, layout.margin)
+        };
         scratch
             .grid
-            .par_chunks_mut(row_len)
+            .par_chunks_mut(grid_row)
             .enumerate()
             .for_each(|(r, row)| {
-                row.fill(zero);
+                row.fill(Complex64::new(0.0, 0.0));
                 for (g, slab) in slabs.iter().enumerate() {
-                    let local = (r as i64 - (g * rows) as i64 + margin as i64).rem_euclid(n as i64)
-                        as usize;
-                    if local < height {
-                        for (v, s) in row
-                            .iter_mut()
-                            .zip(&slab[local * row_len..(local + 1) * row_len])
+                    let mut local = (r as i64 - layout.origin(g)).rem_euclid(n as i64) as usize;
+                    while local < layout.height {
+                        let from = &slab[local * layout.row_len..(local + 1) * layout.row_len];
+                        for (out, line) in row
+                            .chunks_exact_mut(line_out)
+                            .zip(from.chunks_exact(line_in * layout.comps))
                         {
-                            *v += s;
+                            fold_line(out, line, pad, layout.comps);
                         }
+                        local += n;
                     }
                 }
             });
+    }
+
+    /// [`Self::spread_slab`] compiled for AVX2 where the processor has it
+    /// (twice the vector width of baseline x86-64's SSE2), else as is. The
+    /// same operations in the same order either way, never fused into FMAs
+    /// (Rust does not contract a·b + c), so the bits do not depend on the
+    /// processor.
+    fn spread_slab_fastest<const W: usize, const C: usize>(
+        &self,
+        coords: &[f64],
+        strengths: Option<&[Complex64]>,
+        layout: &SlabLayout,
+        origin: i64,
+        slab: &mut [f64],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor supports AVX2, checked just above.
+            unsafe { self.spread_slab_avx2::<W, C>(coords, strengths, layout, origin, slab) };
+            return;
+        }
+        self.spread_slab::<W, C>(coords, strengths, layout, origin, slab)
+    }
+
+    /// [`Self::spread_slab`] with AVX2 enabled.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn spread_slab_avx2<const W: usize, const C: usize>(
+        &self,
+        coords: &[f64],
+        strengths: Option<&[Complex64]>,
+        layout: &SlabLayout,
+        origin: i64,
+        slab: &mut [f64],
+    ) {
+        self.spread_slab::<W, C>(coords, strengths, layout, origin, slab)
+    }
+
+    /// Adds the kernels of the points `coords` (d per point), times their
+    /// `strengths` (1 when `None`), to a slab of `layout` whose last axis
+    /// starts at row `origin`. `W` is the kernel width and `C` the values per cell (1 real,
+    /// 2 complex): constants, so every loop over a kernel row has a fixed
+    /// length.
+    #[inline(always)]
+    fn spread_slab<const W: usize, const C: usize>(
+        &self,
+        coords: &[f64],
+        strengths: Option<&[Complex64]>,
+        layout: &SlabLayout,
+        origin: i64,
+        slab: &mut [f64],
+    ) {
+        let (n, d) = (self.grid as i64, self.freqs.dim);
+        for (j, x) in coords.chunks_exact(d).enumerate() {
+            let mut weights = [[0.0f64; W]; 4];
+            let mut first = [0i64; 4];
+            for (dim, &xj) in x.iter().enumerate() {
+                first[dim] = self.kernel_weights(xj, &mut weights[dim]);
+            }
+            // The first axis's weights times c, interleaved re, im when
+            // complex (c = 1 leaves them exact).
+            let c = strengths.map_or(Complex64::new(1.0, 0.0), |s| s[j]);
+            let mut lead = [[0.0f64; C]; W];
+            for (cell, &wt) in lead.iter_mut().zip(&weights[0]) {
+                cell[0] = c.re * wt;
+                if let Some(im) = cell.get_mut(1) {
+                    *im = c.im * wt;
+                }
+            }
+            let lead = lead.as_flattened();
+            let start0 = if d == 1 {
+                first[0] - origin
+            } else {
+                first[0] + layout.margin as i64
+            } as usize;
+            // Odometer over axes 1..d: the last counts slab rows from
+            // `origin`, the middle ones wrap around the grid.
+            let mut a = [0usize; 4];
+            loop {
+                let (mut base, mut weight) = (0usize, 1.0);
+                if d > 1 {
+                    base = (first[d - 1] + a[d - 1] as i64 - origin) as usize;
+                    weight = weights[d - 1][a[d - 1]];
+                    for dim in (1..d - 1).rev() {
+                        base =
+                            base * n as usize + (first[dim] + a[dim] as i64).rem_euclid(n) as usize;
+                        weight *= weights[dim][a[dim]];
+                    }
+                    base *= layout.line;
+                }
+                let at = (base + start0) * C;
+                for (s, &l) in slab[at..at + W * C].iter_mut().zip(lead) {
+                    *s += weight * l;
+                }
+                let mut dim = 1;
+                while dim < d {
+                    a[dim] += 1;
+                    if a[dim] < W {
+                        break;
+                    }
+                    a[dim] = 0;
+                    dim += 1;
+                }
+                if dim >= d {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// The kernel's w weights around coordinate `xj` into `out` (of length
+    /// w); returns the (unwrapped) grid index of the first.
+    #[inline(always)]
+    fn kernel_weights(&self, xj: f64, out: &mut [f64]) -> i64 {
+        let w = out.len();
+        let t = xj * self.grid as f64;
+        let start = t - 0.5 * w as f64;
+        // ⌈start⌉ by truncation (|start| ≤ n): exact, and without the
+        // libm call `ceil` costs on baseline x86-64 (no SSE4.1 `roundsd`),
+        // which was a third of the spreading's time.
+        let truncated = start as i64;
+        let first = (truncated + i64::from((truncated as f64) < start)) as f64;
+        match &self.polynomial {
+            Some(p) => p.eval(2.0 * (first - start) - 1.0, out),
+            None => {
+                for (a, weight) in out.iter_mut().enumerate() {
+                    let z = 2.0 * (first + a as f64 - t) / w as f64;
+                    *weight = kernel(z, self.beta);
+                }
+            }
+        }
+        first as i64
     }
 
     /// The point indices sorted by the fine-grid bin (BIN^d cells) that
@@ -335,7 +549,12 @@ impl NufftPlan {
     /// is what makes them fast once the grid outgrows the caches (Barnett,
     /// Magland & af Klinteberg 2019, §4.1). The order depends on the points
     /// alone, so results stay identical for any thread count.
-    fn bin_order(&self, points: &PointSet, (order, counts): &mut (Vec<usize>, Vec<usize>)) {
+    ///
+    /// In parallel: the bins of the points in chunks, then one task per
+    /// thread for a contiguous range of bins (a contiguous range of the
+    /// output), each scanning every point's bin and placing those in its
+    /// range. A stable sort has one result, whatever the split.
+    fn bin_order(&self, points: &PointSet, scratch: &mut BinOrder) {
         let d = self.freqs.dim;
         let bin = BIN[d - 1];
         let per_axis = self.grid.div_ceil(bin);
@@ -345,55 +564,70 @@ impl NufftPlan {
                 acc * per_axis + ((v * scale) as usize).min(per_axis - 1)
             })
         };
-        counts.clear();
-        counts.resize(per_axis.pow(d as u32) + 1, 0);
-        for x in points.points() {
-            counts[bin_of(x) + 1] += 1;
+        let BinOrder {
+            order,
+            starts,
+            bins,
+        } = scratch;
+        bins.resize(points.len(), 0);
+        bins.par_chunks_mut(POINTS_PER_TASK)
+            .zip(points.coords().par_chunks(POINTS_PER_TASK * d))
+            .for_each(|(b, x)| {
+                for (b, x) in b.iter_mut().zip(x.chunks_exact(d)) {
+                    *b = bin_of(x);
+                }
+            });
+        // starts[b]: the first output slot of bin b (exclusive prefix sum).
+        let total = per_axis.pow(d as u32);
+        starts.clear();
+        starts.resize(total + 1, 0);
+        for &b in bins.iter() {
+            starts[b + 1] += 1;
         }
-        for b in 1..counts.len() {
-            counts[b] += counts[b - 1];
+        for b in 1..starts.len() {
+            starts[b] += starts[b - 1];
         }
-        order.clear();
+        // Bin ranges of about equal point counts, one per thread.
+        let tasks = rayon::current_num_threads().max(1);
+        let cuts: Vec<usize> = (0..=tasks)
+            .map(|t| {
+                starts
+                    .partition_point(|&s| s < points.len() * t / tasks)
+                    .min(total)
+            })
+            .collect();
         order.resize(points.len(), 0);
-        for (j, x) in points.points().enumerate() {
-            let slot = &mut counts[bin_of(x)];
-            order[*slot] = j;
-            *slot += 1;
+        let mut pieces = Vec::with_capacity(tasks);
+        let mut rest = &mut order[..];
+        for t in 0..tasks {
+            let (piece, tail) = rest.split_at_mut(starts[cuts[t + 1]] - starts[cuts[t]]);
+            pieces.push((cuts[t]..cuts[t + 1], piece));
+            rest = tail;
         }
-    }
-
-    /// Calls `f(cell, ψ-weight)` for the w^d fine-grid cells around x; with
-    /// `origin`, cells of the last axis count from that (unwrapped) row, the
-    /// first of a slab, instead of wrapping around the grid.
-    fn for_each_grid_neighbour(
-        &self,
-        x: &[f64],
-        origin: Option<i64>,
-        mut f: impl FnMut(usize, f64),
-    ) {
-        let (w, n, d) = (self.width, self.grid, self.freqs.dim);
-        let mut weights = [[0.0f64; 16]; 4];
-        let mut cells = [[0usize; 16]; 4];
-        for (dim, &xj) in x.iter().enumerate() {
-            let t = xj * n as f64;
-            let start = t - 0.5 * w as f64;
-            let first = start.ceil();
-            match &self.polynomial {
-                Some(p) => p.eval(2.0 * (first - start) - 1.0, &mut weights[dim][..w]),
-                None => {
-                    for (a, weight) in weights[dim][..w].iter_mut().enumerate() {
-                        let z = 2.0 * (first + a as f64 - t) / w as f64;
-                        *weight = kernel(z, self.beta);
-                    }
+        let (bins, starts) = (&*bins, &*starts);
+        pieces.into_par_iter().for_each(|(range, piece)| {
+            let base = starts[range.start];
+            let mut next: Vec<usize> = starts[range.clone()].iter().map(|s| s - base).collect();
+            for (j, &b) in bins.iter().enumerate() {
+                if range.contains(&b) {
+                    let slot = &mut next[b - range.start];
+                    piece[*slot] = j;
+                    *slot += 1;
                 }
             }
-            let first = first as i64;
-            for (a, cell) in cells[dim][..w].iter_mut().enumerate() {
-                let l = first + a as i64;
-                *cell = match origin {
-                    Some(o) if dim == d - 1 => (l - o) as usize,
-                    _ => l.rem_euclid(n as i64) as usize,
-                };
+        });
+    }
+
+    /// Calls `f(cell, ψ-weight)` for the w^d fine-grid cells around x
+    /// (wrapped around the periodic grid).
+    fn for_each_grid_neighbour<const W: usize>(&self, x: &[f64], mut f: impl FnMut(usize, f64)) {
+        let (n, d) = (self.grid, self.freqs.dim);
+        let mut weights = [[0.0f64; W]; 4];
+        let mut cells = [[0usize; W]; 4];
+        for (dim, &xj) in x.iter().enumerate() {
+            let first = self.kernel_weights(xj, &mut weights[dim]);
+            for (a, cell) in cells[dim].iter_mut().enumerate() {
+                *cell = (first + a as i64).rem_euclid(n as i64) as usize;
             }
         }
         // Odometer over dimensions 1..d; dimension 0 runs contiguously inside.
@@ -405,13 +639,13 @@ impl NufftPlan {
                 weight *= weights[dim][a[dim]];
             }
             base *= n;
-            for a0 in 0..w {
+            for a0 in 0..W {
                 f(base + cells[0][a0], weight * weights[0][a0]);
             }
             let mut dim = 1;
             while dim < d {
                 a[dim] += 1;
-                if a[dim] < w {
+                if a[dim] < W {
                     break;
                 }
                 a[dim] = 0;
@@ -535,6 +769,17 @@ impl NufftPlan {
     }
 }
 
+/// The points' indices in bin order, with the working memory that finds it.
+#[derive(Default)]
+struct BinOrder {
+    /// Point indices, sorted by bin (stable).
+    order: Vec<usize>,
+    /// The first slot of each bin in `order`, and the total at the end.
+    starts: Vec<usize>,
+    /// Each point's bin.
+    bins: Vec<usize>,
+}
+
 /// Fine-grid cells per bin edge in d = 1..4 dimensions (bins of about 4096
 /// cells in 2D, fitting the L1 cache with their kernel margins).
 const BIN: [usize; 4] = [64, 16, 8, 4];
@@ -549,6 +794,124 @@ enum Prune {
     Type1,
     /// Only kept input modes are nonzero.
     Type2,
+}
+
+/// The shape of the spreading slabs ([`NufftPlan::spread`]) for a grid of
+/// n cells per axis in d dimensions and a kernel of width w.
+struct SlabLayout {
+    /// Grid rows of the last axis whose points each slab takes.
+    rows: usize,
+    /// Number of slabs.
+    groups: usize,
+    /// Cells a kernel reaches beyond its point's row on either side.
+    margin: usize,
+    /// Rows of a slab: `rows` plus the margins (and one for a coordinate
+    /// that rounds up to n).
+    height: usize,
+    /// Cells of the first axis in a slab line (padded; d ≥ 2).
+    line: usize,
+    /// Values per slab row: lines × (n^(d−2)) × `comps`.
+    row_len: usize,
+    /// Values per cell: 1 (real strengths of 1) or 2 (complex).
+    comps: usize,
+}
+
+impl SlabLayout {
+    fn new(n: usize, d: usize, width: usize, complex: bool) -> SlabLayout {
+        let (rows, margin) = SlabLayout::rows(n, d, width);
+        let comps = if complex { 2 } else { 1 };
+        let line = if d == 1 { 1 } else { n + 2 * margin + 1 };
+        let middle = if d > 2 { n.pow(d as u32 - 2) } else { 1 };
+        SlabLayout {
+            rows,
+            groups: n.div_ceil(rows),
+            margin,
+            height: rows + 2 * margin + 1,
+            line,
+            row_len: line * middle * comps,
+            comps,
+        }
+    }
+
+    /// The grid row (unwrapped) of slab `g`'s first row.
+    fn origin(&self, g: usize) -> i64 {
+        (g * self.rows) as i64 - self.margin as i64
+    }
+
+    /// Bytes the slabs take with complex strengths (in floating point, so
+    /// that sizes beyond usize are estimated, not overflowed).
+    fn bytes(n: usize, d: usize, width: usize) -> f64 {
+        let (rows, margin) = SlabLayout::rows(n, d, width);
+        let line = if d == 1 {
+            1.0
+        } else {
+            (n + 2 * margin + 1) as f64
+        };
+        let middle = (n as f64).powi(d.saturating_sub(2) as i32);
+        n.div_ceil(rows) as f64 * (rows + 2 * margin + 1) as f64 * line * middle * 2.0 * 8.0
+    }
+
+    /// Rows per group and the kernel's margin.
+    fn rows(n: usize, d: usize, width: usize) -> (usize, usize) {
+        let bin = BIN[d - 1];
+        let margin = width.div_ceil(2);
+        let rows = width.div_ceil(bin).max(1) * bin;
+        if n.div_ceil(rows) < 2 || rows + 2 * margin + 1 > n {
+            (n, margin)
+        } else {
+            (rows, margin)
+        }
+    }
+}
+
+/// Copies the points' coordinates (and strengths, when given) in `order`
+/// into `sorted`, in parallel chunks: independent loads the processor
+/// overlaps, unlike the same reads interleaved with the kernel arithmetic.
+fn gather_sorted(
+    points: &PointSet,
+    strengths: Option<&[Complex64]>,
+    order: &[usize],
+    (coords, sorted_strengths): &mut (Vec<f64>, Vec<Complex64>),
+) {
+    let d = points.dim();
+    coords.resize(order.len() * d, 0.0);
+    coords
+        .par_chunks_mut(POINTS_PER_TASK * d)
+        .zip(order.par_chunks(POINTS_PER_TASK))
+        .for_each(|(out, indices)| {
+            for (x, &j) in out.chunks_exact_mut(d).zip(indices) {
+                // Element by element: `copy_from_slice` of d values was a
+                // memcpy call per point (a tenth of the transform's time).
+                let p = points.point(j);
+                #[allow(clippy::manual_memcpy)]
+                for k in 0..d {
+                    x[k] = p[k];
+                }
+            }
+        });
+    if let Some(s) = strengths {
+        sorted_strengths.clear();
+        sorted_strengths.par_extend(order.par_iter().map(|&j| s[j]));
+    }
+}
+
+/// Adds a padded slab line (`pad` cells before the grid's first, the rest
+/// after its last; `comps` values per cell) onto a periodic grid line.
+#[inline]
+fn fold_line(out: &mut [Complex64], line: &[f64], pad: usize, comps: usize) {
+    let n = out.len();
+    let mut t = (n - pad % n) % n;
+    for v in line.chunks_exact(comps) {
+        let cell = &mut out[t];
+        cell.re += v[0];
+        if comps == 2 {
+            cell.im += v[1];
+        }
+        t += 1;
+        if t == n {
+            t = 0;
+        }
+    }
 }
 
 /// The kernel on the w cells around a point as polynomials of its offset:
@@ -632,10 +995,12 @@ impl KernelPolynomial {
         None
     }
 
-    /// φ at the w cells for offset s = 2δ − 1, into `out`.
-    #[inline]
+    /// φ at the w cells for offset s = 2δ − 1, into `out` (of length w: a
+    /// fixed-size array there makes every loop below fixed-length).
+    #[inline(always)]
     fn eval(&self, s: f64, out: &mut [f64]) {
-        let w = self.width;
+        let w = out.len();
+        debug_assert_eq!(w, self.width);
         out.copy_from_slice(&self.coeffs[self.degree * w..(self.degree + 1) * w]);
         for j in (0..self.degree).rev() {
             let c = &self.coeffs[j * w..(j + 1) * w];
@@ -646,10 +1011,13 @@ impl KernelPolynomial {
     }
 }
 
+/// The widest kernel, in grid points (ε = 1e-14 and below).
+const MAX_WIDTH: usize = 16;
+
 /// Width w = ⌈log10(1/ε)⌉ + 1 grid points (2 to 16) and β = 2.30·w of the
 /// kernel for tolerance ε (BMK 2019, §3 and Eq. (3.2)).
 fn kernel_shape(tolerance: f64) -> (usize, f64) {
-    let width = ((1.0 / tolerance).log10().ceil() as usize + 1).clamp(2, 16);
+    let width = ((1.0 / tolerance).log10().ceil() as usize + 1).clamp(2, MAX_WIDTH);
     (width, 2.30 * width as f64)
 }
 
@@ -677,22 +1045,27 @@ fn kernel_transform(xi: f64, width: usize, beta: f64) -> f64 {
     0.5 * w * sum
 }
 
-/// Bytes a plan on `freqs` holds at most: a fine grid of twice the box's
-/// side per thread (four buffers) and 24 bytes per frequency; `None` when
-/// the box's size overflows.
+/// Bytes a plan on `freqs` holds at most: per thread, two complex fine
+/// grids and the spreading slabs (sized for the widest kernel), and 24
+/// bytes per frequency; `None` when the box's size overflows.
 pub fn nufft_memory_bytes(freqs: &FrequencyBox) -> Option<f64> {
+    let len = freqs.checked_len()?;
     let threads = rayon::current_num_threads() as f64;
-    let side = freqs.side() as f64;
-    let d = freqs.dim as i32;
-    freqs
-        .checked_len()
-        .map(|len| threads * 4.0 * (2.0 * side).powi(d) * 16.0 + len as f64 * 24.0)
+    let d = freqs.dim;
+    let n = fine_grid_size(2 * freqs.side()).max(2 * MAX_WIDTH);
+    let grid = (n as f64).powi(d as i32) * 16.0;
+    Some(threads * (2.0 * grid + SlabLayout::bytes(n, d, MAX_WIDTH)) + len as f64 * 24.0)
 }
 
-/// The smallest 2^a·3^b·5^c ≥ `min` (sizes RustFFT handles fastest).
-/// Refuses a box whose transform would not fit in memory: each thread holds
-/// two complex fine grids of at least (2(2h+1))^d cells and the spreading
-/// slabs (at most two grids more), plus the box's coefficients.
+/// Bytes a transform's scratch holds per point, besides its grids: the bin
+/// order, each point's bin, and the coordinates and strengths copied in
+/// bin order.
+pub fn nufft_point_bytes(dim: usize) -> f64 {
+    8.0 * 2.0 + 8.0 * dim as f64 + 16.0
+}
+
+/// Refuses a box whose transform would not fit in memory
+/// ([`nufft_memory_bytes`]).
 ///
 /// # Errors
 /// [`SpectrumError::TooLarge`] with the estimate.
@@ -711,18 +1084,39 @@ pub fn check_nufft_memory(freqs: &FrequencyBox) -> Result<(), SpectrumError> {
     Ok(())
 }
 
+/// The smallest even 2^a·3^b·5^c ≥ `min` (sizes RustFFT handles fastest).
 fn fine_grid_size(min: usize) -> usize {
-    (min..)
-        .find(|&n| {
-            let mut m = n;
-            for p in [2, 3, 5] {
-                while m % p == 0 {
-                    m /= p;
-                }
+    // Every even 2^a·3^b·5^c is 2·3^b·5^c times a power of two: for each
+    // (b, c) with 2·3^b·5^c below `min`, the first power-of-two multiple
+    // at or above it. O(log³ min) steps, so a huge box is estimated (and
+    // refused) at once instead of searched number by number.
+    let mut best = usize::MAX;
+    let mut p3 = 2usize;
+    loop {
+        let mut p35 = p3;
+        loop {
+            let mut n = p35;
+            while n < min {
+                n = n.saturating_mul(2);
             }
-            m == 1 && n % 2 == 0
-        })
-        .expect("a smooth number exists")
+            best = best.min(n);
+            if p35 >= min {
+                break;
+            }
+            p35 = match p35.checked_mul(5) {
+                Some(v) => v,
+                None => break,
+            };
+        }
+        if p3 >= min {
+            break;
+        }
+        p3 = match p3.checked_mul(3) {
+            Some(v) => v,
+            None => break,
+        };
+    }
+    best
 }
 
 #[cfg(test)]
@@ -734,6 +1128,23 @@ mod tests {
         assert_eq!(fine_grid_size(510), 512);
         assert_eq!(fine_grid_size(7), 8);
         assert_eq!(fine_grid_size(250), 250);
+        assert_eq!(fine_grid_size(13), 16);
+        assert_eq!(fine_grid_size(2 * 513), 1080);
+        // Against the definition, number by number.
+        for min in 1..3000 {
+            let smooth = |n: usize| {
+                let mut m = n;
+                for p in [2, 3, 5] {
+                    while m % p == 0 {
+                        m /= p;
+                    }
+                }
+                m == 1 && n % 2 == 0
+            };
+            let first = (min..).find(|&n| smooth(n)).unwrap();
+            assert_eq!(fine_grid_size(min), first, "min = {min}");
+        }
+        assert!(fine_grid_size(usize::MAX / 3) >= usize::MAX / 3);
     }
 
     #[test]
