@@ -329,6 +329,22 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
                     max_rel_error: None,
                 },
             );
+            // Type 2 (modes to points, the optimizer's gradient step) from
+            // the type-1 output as coefficients.
+            let mut values = vec![Complex64::new(0.0, 0.0); n];
+            let (secs, ()) = time(3, || {
+                plan.type2(&points, &out, Sign::Positive, &mut values, &mut scratch)
+            });
+            push(
+                &mut rows,
+                Row {
+                    case: format!("random N={n}, 512^2 box"),
+                    method: format!("fast type 2 tol={tol:e}"),
+                    seconds: secs,
+                    max_power_error: None,
+                    max_rel_error: None,
+                },
+            );
         }
     }
     write_atomic(&a.csv, |w| {

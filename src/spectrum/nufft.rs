@@ -162,8 +162,9 @@ impl NufftPlan {
         let (width, beta) = kernel_shape(tolerance);
         let grid = fine_grid_size(2 * freqs.side()).max(2 * width);
         let h = freqs.half as i64;
+        let rule = crate::quadrature::gauss_legendre(4 * width + 40);
         let correction = (-h..=h)
-            .map(|k| 1.0 / kernel_transform(k as f64 / grid as f64, width, beta))
+            .map(|k| 1.0 / kernel_transform(k as f64 / grid as f64, width, beta, &rule))
             .collect();
         let mode_cells = (-h..=h)
             .map(|k| k.rem_euclid(grid as i64) as usize)
@@ -283,15 +284,7 @@ impl NufftPlan {
         let d = self.freqs.dim;
         let values: Vec<Complex64> = with_width!(self.width, W => coords
             .par_chunks(POINTS_PER_TASK * d)
-            .flat_map_iter(|chunk| {
-                chunk.chunks_exact(d).map(|x| {
-                    let mut acc = Complex64::new(0.0, 0.0);
-                    self.for_each_grid_neighbour::<W>(x, |cell, weight| {
-                        acc += grid[cell] * weight
-                    });
-                    acc
-                })
-            })
+            .flat_map_iter(|chunk| self.interpolate_fastest::<W>(chunk, grid))
             .collect());
         for (&j, v) in order.iter().zip(values) {
             out[j] = v;
@@ -618,43 +611,96 @@ impl NufftPlan {
         });
     }
 
-    /// Calls `f(cell, ψ-weight)` for the w^d fine-grid cells around x
-    /// (wrapped around the periodic grid).
-    fn for_each_grid_neighbour<const W: usize>(&self, x: &[f64], mut f: impl FnMut(usize, f64)) {
+    /// [`Self::interpolate`] compiled for AVX2 where the processor has it,
+    /// else as is (the same bits either way: see
+    /// [`Self::spread_slab_fastest`]).
+    fn interpolate_fastest<const W: usize>(
+        &self,
+        coords: &[f64],
+        grid: &[Complex64],
+    ) -> Vec<Complex64> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor supports AVX2, checked just above.
+            return unsafe { self.interpolate_avx2::<W>(coords, grid) };
+        }
+        self.interpolate::<W>(coords, grid)
+    }
+
+    /// [`Self::interpolate`] with AVX2 enabled.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn interpolate_avx2<const W: usize>(
+        &self,
+        coords: &[f64],
+        grid: &[Complex64],
+    ) -> Vec<Complex64> {
+        self.interpolate::<W>(coords, grid)
+    }
+
+    /// Σ_cells grid·ψ-weight around each point of `coords` (d per point):
+    /// the type-2 interpolation, for a kernel of width `W`. The rows of
+    /// the first axis are summed column by column (W independent sums the
+    /// compiler vectorises, read contiguously where the kernel does not
+    /// wrap), then weighted along the first axis.
+    #[inline(always)]
+    fn interpolate<const W: usize>(&self, coords: &[f64], grid: &[Complex64]) -> Vec<Complex64> {
         let (n, d) = (self.grid, self.freqs.dim);
-        let mut weights = [[0.0f64; W]; 4];
-        let mut cells = [[0usize; W]; 4];
-        for (dim, &xj) in x.iter().enumerate() {
-            let first = self.kernel_weights(xj, &mut weights[dim]);
-            for (a, cell) in cells[dim].iter_mut().enumerate() {
-                *cell = (first + a as i64).rem_euclid(n as i64) as usize;
-            }
-        }
-        // Odometer over dimensions 1..d; dimension 0 runs contiguously inside.
-        let mut a = [0usize; 4];
-        loop {
-            let (mut base, mut weight) = (0usize, 1.0);
-            for dim in (1..d).rev() {
-                base = base * n + cells[dim][a[dim]];
-                weight *= weights[dim][a[dim]];
-            }
-            base *= n;
-            for a0 in 0..W {
-                f(base + cells[0][a0], weight * weights[0][a0]);
-            }
-            let mut dim = 1;
-            while dim < d {
-                a[dim] += 1;
-                if a[dim] < W {
-                    break;
+        let zero = Complex64::new(0.0, 0.0);
+        // A plain loop, not an iterator adapter: an adapter's `fold` is a
+        // function of its own, compiled without the caller's AVX2.
+        let mut values = Vec::with_capacity(coords.len() / d);
+        for x in coords.chunks_exact(d) {
+            {
+                let mut weights = [[0.0f64; W]; 4];
+                let mut first = [0i64; 4];
+                for (dim, &xj) in x.iter().enumerate() {
+                    first[dim] = self.kernel_weights(xj, &mut weights[dim]);
                 }
-                a[dim] = 0;
-                dim += 1;
-            }
-            if dim >= d {
-                return;
+                let wrapped =
+                    |dim: usize, a: usize| (first[dim] + a as i64).rem_euclid(n as i64) as usize;
+                let contiguous = first[0] >= 0 && first[0] as usize + W <= n;
+                let mut columns = [zero; W];
+                // Odometer over axes 1..d.
+                let mut a = [0usize; 4];
+                loop {
+                    let (mut base, mut weight) = (0usize, 1.0);
+                    for dim in (1..d).rev() {
+                        base = base * n + wrapped(dim, a[dim]);
+                        weight *= weights[dim][a[dim]];
+                    }
+                    base *= n;
+                    if contiguous {
+                        let start = base + first[0] as usize;
+                        for (c, g) in columns.iter_mut().zip(&grid[start..start + W]) {
+                            *c += g * weight;
+                        }
+                    } else {
+                        for (a0, c) in columns.iter_mut().enumerate() {
+                            *c += grid[base + wrapped(0, a0)] * weight;
+                        }
+                    }
+                    let mut dim = 1;
+                    while dim < d {
+                        a[dim] += 1;
+                        if a[dim] < W {
+                            break;
+                        }
+                        a[dim] = 0;
+                        dim += 1;
+                    }
+                    if dim >= d {
+                        break;
+                    }
+                }
+                let mut value = zero;
+                for (c, &w0) in columns.iter().zip(&weights[0]) {
+                    value += c * w0;
+                }
+                values.push(value);
             }
         }
+        values
     }
 
     /// In-place d-D FFT of the fine grid, axis by axis, pruned to the lines
@@ -1033,13 +1079,18 @@ fn kernel(z: f64, beta: f64) -> f64 {
 }
 
 /// ψ̂(ξ) = ∫ ψ(u) e^(−2πiξu) du = (w/2) ∫_(−1)^(1) φ(z) cos(π w ξ z) dz, by
-/// Gauss–Legendre quadrature with enough nodes for double precision.
-fn kernel_transform(xi: f64, width: usize, beta: f64) -> f64 {
-    let (nodes, weights) = crate::quadrature::gauss_legendre(4 * width + 40);
+/// Gauss–Legendre quadrature `(nodes, weights)` with enough nodes for
+/// double precision (4w + 40, computed once per plan).
+fn kernel_transform(
+    xi: f64,
+    width: usize,
+    beta: f64,
+    (nodes, weights): &(Vec<f64>, Vec<f64>),
+) -> f64 {
     let w = width as f64;
     let sum: f64 = nodes
         .iter()
-        .zip(&weights)
+        .zip(weights)
         .map(|(&z, &q)| q * kernel(z, beta) * (std::f64::consts::PI * w * xi * z).cos())
         .sum();
     0.5 * w * sum
