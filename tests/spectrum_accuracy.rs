@@ -19,6 +19,14 @@ fn zero() -> Complex64 {
     Complex64::new(0.0, 0.0)
 }
 
+/// max_i |a_i − b_i|.
+fn max_difference(a: &[Complex64], b: &[Complex64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).norm())
+        .fold(0.0, f64::max)
+}
+
 /// The type-1 error bound of the ES-kernel NUFFT (Barnett et al. 2019):
 /// |ΔS(k)| ≤ ε·Σ_j |c_j| = ε·N, and so for the power N·P_S = |S|²/N,
 /// |ΔP| ≤ (2|S|·εN + (εN)²)/N.
@@ -111,11 +119,7 @@ fn type1_with_strengths_matches_direct_sums() {
                 &mut fast,
                 &mut plan.make_scratch(),
             );
-            let worst = fast
-                .iter()
-                .zip(&exact)
-                .map(|(f, e)| (f - e).norm())
-                .fold(0.0, f64::max);
+            let worst = max_difference(&fast, &exact);
             assert!(
                 worst <= tol * l1,
                 "d={d} half={half} tol={tol:e}: |dF| = {worst:e} > eps*sum|c| = {:e}",
@@ -147,11 +151,7 @@ fn type2_matches_direct_within_its_tolerance() {
                 &mut fast,
                 &mut plan.make_scratch(),
             );
-            let worst = fast
-                .iter()
-                .zip(&exact)
-                .map(|(f, e)| (f - e).norm())
-                .fold(0.0, f64::max);
+            let worst = max_difference(&fast, &exact);
             assert!(
                 worst <= tol * l1,
                 "d={d} tol={tol:e}: |dc| = {worst} > eps*sum|F| = {}",
@@ -343,12 +343,7 @@ fn parallel_spreading_is_thread_count_independent_and_accurate() {
     let (one, two) = (run(1), run(2));
     assert!(one == two, "results differ between 1 and 2 threads");
     let exact = sample_spectrum(&p, &b);
-    let worst = one
-        .0
-        .iter()
-        .zip(&exact)
-        .map(|(a, e)| (a - e).norm())
-        .fold(0.0, f64::max);
+    let worst = max_difference(&one.0, &exact);
     assert!(
         worst <= 1e-9 * p.len() as f64,
         "type 1: max |ΔS| = {worst:e} above ε·N"

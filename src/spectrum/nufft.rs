@@ -456,11 +456,8 @@ impl NufftPlan {
     ) {
         let (n, d) = (self.grid as i64, self.freqs.dim);
         for (j, x) in coords.chunks_exact(d).enumerate() {
-            let mut weights = [[0.0f64; W]; 4];
-            let mut first = [0i64; 4];
-            for (dim, &xj) in x.iter().enumerate() {
-                first[dim] = self.kernel_weights(xj, &mut weights[dim]);
-            }
+            let (mut weights, mut first) = ([[0.0f64; W]; 4], [0i64; 4]);
+            self.point_kernel::<W>(x, &mut weights, &mut first);
             // The first axis's weights times c, interleaved re, im when
             // complex (c = 1 leaves them exact).
             let c = strengths.map_or(Complex64::new(1.0, 0.0), |s| s[j]);
@@ -496,19 +493,25 @@ impl NufftPlan {
                 for (s, &l) in slab[at..at + W * C].iter_mut().zip(lead) {
                     *s += weight * l;
                 }
-                let mut dim = 1;
-                while dim < d {
-                    a[dim] += 1;
-                    if a[dim] < W {
-                        break;
-                    }
-                    a[dim] = 0;
-                    dim += 1;
-                }
-                if dim >= d {
+                if !next_cell::<W>(&mut a, d) {
                     break;
                 }
             }
+        }
+    }
+
+    /// The kernel's weights on each axis around the point `x` into
+    /// `weights`, and the (unwrapped) grid index of each axis's first cell
+    /// into `first`.
+    #[inline(always)]
+    fn point_kernel<const W: usize>(
+        &self,
+        x: &[f64],
+        weights: &mut [[f64; W]; 4],
+        first: &mut [i64; 4],
+    ) {
+        for (dim, &xj) in x.iter().enumerate() {
+            first[dim] = self.kernel_weights(xj, &mut weights[dim]);
         }
     }
 
@@ -651,54 +654,40 @@ impl NufftPlan {
         // function of its own, compiled without the caller's AVX2.
         let mut values = Vec::with_capacity(coords.len() / d);
         for x in coords.chunks_exact(d) {
-            {
-                let mut weights = [[0.0f64; W]; 4];
-                let mut first = [0i64; 4];
-                for (dim, &xj) in x.iter().enumerate() {
-                    first[dim] = self.kernel_weights(xj, &mut weights[dim]);
+            let (mut weights, mut first) = ([[0.0f64; W]; 4], [0i64; 4]);
+            self.point_kernel::<W>(x, &mut weights, &mut first);
+            let wrapped =
+                |dim: usize, a: usize| (first[dim] + a as i64).rem_euclid(n as i64) as usize;
+            let contiguous = first[0] >= 0 && first[0] as usize + W <= n;
+            let mut columns = [zero; W];
+            // Odometer over axes 1..d.
+            let mut a = [0usize; 4];
+            loop {
+                let (mut base, mut weight) = (0usize, 1.0);
+                for dim in (1..d).rev() {
+                    base = base * n + wrapped(dim, a[dim]);
+                    weight *= weights[dim][a[dim]];
                 }
-                let wrapped =
-                    |dim: usize, a: usize| (first[dim] + a as i64).rem_euclid(n as i64) as usize;
-                let contiguous = first[0] >= 0 && first[0] as usize + W <= n;
-                let mut columns = [zero; W];
-                // Odometer over axes 1..d.
-                let mut a = [0usize; 4];
-                loop {
-                    let (mut base, mut weight) = (0usize, 1.0);
-                    for dim in (1..d).rev() {
-                        base = base * n + wrapped(dim, a[dim]);
-                        weight *= weights[dim][a[dim]];
+                base *= n;
+                if contiguous {
+                    let start = base + first[0] as usize;
+                    for (c, g) in columns.iter_mut().zip(&grid[start..start + W]) {
+                        *c += g * weight;
                     }
-                    base *= n;
-                    if contiguous {
-                        let start = base + first[0] as usize;
-                        for (c, g) in columns.iter_mut().zip(&grid[start..start + W]) {
-                            *c += g * weight;
-                        }
-                    } else {
-                        for (a0, c) in columns.iter_mut().enumerate() {
-                            *c += grid[base + wrapped(0, a0)] * weight;
-                        }
-                    }
-                    let mut dim = 1;
-                    while dim < d {
-                        a[dim] += 1;
-                        if a[dim] < W {
-                            break;
-                        }
-                        a[dim] = 0;
-                        dim += 1;
-                    }
-                    if dim >= d {
-                        break;
+                } else {
+                    for (a0, c) in columns.iter_mut().enumerate() {
+                        *c += grid[base + wrapped(0, a0)] * weight;
                     }
                 }
-                let mut value = zero;
-                for (c, &w0) in columns.iter().zip(&weights[0]) {
-                    value += c * w0;
+                if !next_cell::<W>(&mut a, d) {
+                    break;
                 }
-                values.push(value);
             }
+            let mut value = zero;
+            for (c, &w0) in columns.iter().zip(&weights[0]) {
+                value += c * w0;
+            }
+            values.push(value);
         }
         values
     }
@@ -908,6 +897,22 @@ impl SlabLayout {
             (rows, margin)
         }
     }
+}
+
+/// Advances the odometer `a` over the kernel's cells on axes 1..d (axis 0
+/// is run through inside); false when every cell has been visited.
+#[inline(always)]
+fn next_cell<const W: usize>(a: &mut [usize; 4], d: usize) -> bool {
+    let mut dim = 1;
+    while dim < d {
+        a[dim] += 1;
+        if a[dim] < W {
+            return true;
+        }
+        a[dim] = 0;
+        dim += 1;
+    }
+    false
 }
 
 /// Copies the points' coordinates (and strengths, when given) in `order`
