@@ -258,3 +258,111 @@ fn a_disk_light_sampled_on_its_area_or_its_bounding_square_gives_one_image() {
     }
     assert!(differ > 0, "the two samplings must be different estimators");
 }
+
+/// A striped 3 × 2 rectangle at depth 6, its edges inside the view
+/// (misses see the ambient 1; the stripes are 0.2 and 0.8), its quad given by `shape` (e.g.
+/// `"shape": "quad"` or an OBJ file).
+fn plane_text(shape: &str) -> String {
+    format!(
+        r#"{{
+  "camera": {{"resolution": [16, 16], "fov_degrees": 40, "position": [0, 0, 0],
+              "look_at": [0, 0, -1], "focal_distance": 3, "aperture": 0.1}},
+  "integrand": "lens",
+  "ambient": 1.0,
+  "objects": [{{{shape}, "scale": [1.5, 1, 1], "translate": [0.013, 0, -6],
+                "material": {{"texture": "stripes", "period": 0.3, "low": 0.2, "high": 0.8}}}}]
+}}"#
+    )
+}
+
+/// An OBJ file holding the built-in quad (one polygon face, triangulated as
+/// a fan into the built-in quad's two triangles), read relative to the
+/// scene file's folder, renders exactly the built-in quad's pixels.
+#[test]
+fn an_obj_mesh_renders_as_the_built_in_shape_it_holds() {
+    let dir = std::env::temp_dir().join(format!("varspec-obj-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    std::fs::write(
+        dir.join("meshes/quad.obj"),
+        "# the built-in quad\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n",
+    )
+    .unwrap();
+    let scene_path = dir.join("plane.json");
+    std::fs::write(
+        &scene_path,
+        plane_text(r#""shape": "obj", "file": "meshes/quad.obj""#),
+    )
+    .unwrap();
+    let from_obj = Scene::load(scene_path.to_str().unwrap()).unwrap();
+    let built_in = Scene::from_text(&plane_text(r#""shape": "quad""#), "quad").unwrap();
+    assert_eq!(from_obj.geometry().triangle_count(), 2);
+    let mut lit = 0;
+    for i in 0..400 {
+        let p = [
+            0.37 * i as f64 % 1.0,
+            0.61 * i as f64 % 1.0,
+            0.13 * i as f64 % 1.0,
+            0.29 * i as f64 % 1.0,
+        ];
+        let (px, py) = (i % 16, (i / 16) % 16);
+        let value = from_obj.radiance(px, py, p);
+        assert_eq!(
+            value,
+            built_in.radiance(px, py, p),
+            "pixel ({px}, {py}) at {p:?}"
+        );
+        lit += usize::from(value != 1.0);
+    }
+    assert!(
+        lit > 40 && lit < 360,
+        "the rectangle and the background must both show ({lit} of 400 on the rectangle)"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Bad `obj` objects and bad OBJ files are refused with an error that names
+/// the field (and, for the file, what is wrong with it).
+#[test]
+fn bad_obj_meshes_are_refused_naming_the_field() {
+    let dir = std::env::temp_dir().join(format!("varspec-badobj-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let files = [
+        ("far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "vertex"),
+        ("empty.obj", "v 0 0 0\nv 1 0 0\n", "at least one face"),
+        (
+            "nan.obj",
+            "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            "finite",
+        ),
+    ];
+    let mut cases: Vec<(String, &str)> = vec![
+        (r#""shape": "obj""#.into(), "objects[0].file"),
+        (
+            r#""shape": "quad", "file": "a.obj""#.into(),
+            "only with shape `obj`",
+        ),
+        (
+            r#""shape": "obj", "file": "missing.obj""#.into(),
+            "missing.obj",
+        ),
+    ];
+    for (name, text, _) in &files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    for (name, _, phrase) in &files {
+        cases.push((format!(r#""shape": "obj", "file": "{name}""#), phrase));
+    }
+    for (shape, phrase) in cases {
+        let path = dir.join("scene.json");
+        std::fs::write(&path, plane_text(&shape)).unwrap();
+        let message = match Scene::load(path.to_str().unwrap()) {
+            Ok(_) => panic!("{shape}: accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            message.contains(phrase) && message.contains("objects[0]"),
+            "{shape}: {message:?} should name objects[0] and say {phrase:?}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -63,8 +63,13 @@ fn default_up() -> [f64; 3] {
 #[serde(deny_unknown_fields)]
 pub struct ObjectFile {
     /// Built-in shape: `quad` ([−1, 1]² in the xy plane, normal +z),
-    /// `box` ([−1, 1]³) or `sphere` (unit radius, tessellated).
+    /// `box` ([−1, 1]³) or `sphere` (unit radius, tessellated); or `obj`, a
+    /// triangle mesh read from `file`.
     pub shape: ShapeKind,
+    /// The Wavefront OBJ file of an `obj` shape (relative to the scene
+    /// file's folder); model-space positions, faces triangulated as fans.
+    #[serde(default)]
+    pub file: Option<String>,
     /// Scale per axis, applied first.
     #[serde(default = "unit_scale")]
     pub scale: [f64; 3],
@@ -99,6 +104,8 @@ pub enum ShapeKind {
     Box,
     /// A subdivided icosahedron.
     Sphere,
+    /// A Wavefront OBJ mesh (`file`).
+    Obj,
 }
 
 /// A diffuse material: albedo in [0, 1], constant or a solid texture in the
@@ -310,6 +317,23 @@ impl SceneFile {
                     o.rotate_y_degrees.to_string(),
                     FINITE,
                 ));
+            }
+            match (o.shape, &o.file) {
+                (ShapeKind::Obj, None) => {
+                    return Err(bad(
+                        field("file"),
+                        "(missing)".into(),
+                        "the OBJ file of an `obj` shape",
+                    ));
+                }
+                (ShapeKind::Obj, Some(_)) | (_, None) => {}
+                (_, Some(file)) => {
+                    return Err(bad(
+                        field("file"),
+                        file.clone(),
+                        "only with shape `obj` (built-in shapes have no file)",
+                    ));
+                }
             }
             if o.subdivisions > 7 {
                 return Err(bad(

@@ -16,6 +16,7 @@ use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 
 use super::description::{ObjectFile, ShapeKind};
+use super::mesh::ModelTriangle;
 
 /// A rigid placement: scale, then rotation about y, then translation.
 #[derive(Debug, Clone, Copy)]
@@ -68,9 +69,11 @@ impl Placement {
     }
 }
 
-/// The model-space triangles of a built-in shape.
-pub fn shape_triangles(shape: ShapeKind, subdivisions: u32) -> Vec<[[f64; 3]; 3]> {
-    match shape {
+/// The model-space triangles of a built-in shape; `None` for an `obj`
+/// shape, whose triangles come from its file ([`super::mesh`]).
+pub fn shape_triangles(shape: ShapeKind, subdivisions: u32) -> Option<Vec<ModelTriangle>> {
+    Some(match shape {
+        ShapeKind::Obj => return None,
         ShapeKind::Quad => vec![
             [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0]],
             [[-1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]],
@@ -95,7 +98,7 @@ pub fn shape_triangles(shape: ShapeKind, subdivisions: u32) -> Vec<[[f64; 3]; 3]
             out
         }
         ShapeKind::Sphere => icosphere(subdivisions),
-    }
+    })
 }
 
 /// A unit icosahedron subdivided `levels` times, vertices on the sphere
@@ -194,18 +197,18 @@ pub struct Geometry {
 }
 
 impl Geometry {
-    /// Builds the default BVH (BVH2) over the objects' triangles.
-    pub fn build(objects: &[ObjectFile]) -> Geometry {
-        Geometry::build_with(objects, BvhKind::Bvh2)
-    }
-
-    /// Builds a BVH of the given kind over the objects' triangles.
-    pub fn build_with(objects: &[ObjectFile], kind: BvhKind) -> Geometry {
+    /// Builds a BVH of the given kind over the objects' triangles:
+    /// `meshes[i]` holds object i's in model space.
+    pub fn build_with(
+        objects: &[ObjectFile],
+        meshes: &[Vec<ModelTriangle>],
+        kind: BvhKind,
+    ) -> Geometry {
         let mut triangles = Vec::new();
         let mut object_of = Vec::new();
-        for (i, o) in objects.iter().enumerate() {
+        for (i, (o, mesh)) in objects.iter().zip(meshes).enumerate() {
             let place = Placement::of(o);
-            for [a, b, c] in shape_triangles(o.shape, o.subdivisions) {
+            for &[a, b, c] in mesh {
                 let v = |p| {
                     let q = place.apply(p);
                     Vec3A::new(q[0] as f32, q[1] as f32, q[2] as f32)

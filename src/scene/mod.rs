@@ -8,6 +8,7 @@ pub mod camera;
 pub mod description;
 pub mod geometry;
 pub mod image;
+pub mod mesh;
 pub mod render;
 
 use camera::Camera;
@@ -160,7 +161,8 @@ impl Scene {
             path: name_or_path.into(),
             cause,
         })?;
-        Scene::from_text(&text, name_or_path)
+        let folder = path.parent().unwrap_or(std::path::Path::new(""));
+        Scene::build(&text, name_or_path, folder, BvhKind::Bvh2)
     }
 
     /// A scene from JSON text; `name` names it in errors and reports.
@@ -171,16 +173,33 @@ impl Scene {
         Scene::from_text_with(text, name, BvhKind::Bvh2)
     }
 
-    /// As [`Self::from_text`] with a chosen BVH.
+    /// As [`Self::from_text`] with a chosen BVH (OBJ files relative to
+    /// the current folder).
     ///
     /// # Errors
     /// [`SceneError::Syntax`] or [`SceneError::Field`].
     pub fn from_text_with(text: &str, name: &str, bvh: BvhKind) -> Result<Scene, SceneError> {
+        Scene::build(text, name, std::path::Path::new(""), bvh)
+    }
+
+    /// Parses, reads the OBJ meshes (relative to `folder`) and builds.
+    fn build(
+        text: &str,
+        name: &str,
+        folder: &std::path::Path,
+        bvh: BvhKind,
+    ) -> Result<Scene, SceneError> {
         let file = SceneFile::parse(text, name)?;
+        let meshes = file
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| mesh::object_triangles(o, i, name, folder))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Scene {
             name: name.into(),
             camera: Camera::new(&file.camera),
-            geometry: Geometry::build_with(&file.objects, bvh),
+            geometry: Geometry::build_with(&file.objects, &meshes, bvh),
             placements: file.objects.iter().map(Placement::of).collect(),
             lights: file.lights.iter().map(Light::new).collect(),
             file,

@@ -1,0 +1,99 @@
+//! The triangles of a scene object in model space: a built-in shape's, or
+//! a Wavefront OBJ file's, read by the `tobj` crate (polygons triangulated
+//! as fans; points and lines ignored; materials ignored: the scene file
+//! gives the object's material).
+
+use std::path::Path;
+
+use super::description::{ObjectFile, SceneError};
+use super::geometry::shape_triangles;
+
+/// A triangle's three vertices in model space.
+pub type ModelTriangle = [[f64; 3]; 3];
+
+/// An upper bound on the bytes a mesh takes per byte of its OBJ text: a
+/// face line of 8 bytes (`f 1 2 3`) becomes a 72-byte f64 triangle, tobj's
+/// 12 bytes of indices, a 48-byte f32 BVH triangle and its share of the
+/// BVH's nodes.
+const BYTES_PER_OBJ_BYTE: f64 = 32.0;
+
+/// Object `index`'s triangles: its built-in shape's, or its OBJ file's
+/// (`file` relative to `folder`).
+///
+/// # Errors
+/// [`SceneError::Field`] on `objects[index].file`: unreadable, too large
+/// for memory, malformed, no faces, a non-finite position or a face that
+/// refers to a missing vertex.
+pub fn object_triangles(
+    object: &ObjectFile,
+    index: usize,
+    source_name: &str,
+    folder: &Path,
+) -> Result<Vec<ModelTriangle>, SceneError> {
+    if let Some(triangles) = shape_triangles(object.shape, object.subdivisions) {
+        return Ok(triangles);
+    }
+    let file = object.file.clone().unwrap_or_default();
+    read_obj(&folder.join(&file)).map_err(|expected| SceneError::Field {
+        source_name: source_name.into(),
+        field: format!("objects[{index}].file"),
+        value: file,
+        expected,
+    })
+}
+
+/// The triangles of an OBJ file; the error says what a usable file is and
+/// what this one is not.
+pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
+    let bytes = std::fs::metadata(path)
+        .map_err(|e| format!("a readable Wavefront OBJ file ({}: {e})", path.display()))?
+        .len();
+    crate::memory::check(
+        &format!("the mesh {}", path.display()),
+        Some(bytes as f64 * BYTES_PER_OBJ_BYTE),
+        "use a smaller mesh",
+    )
+    .map_err(|e| e.to_string())?;
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let (models, _materials) = tobj::load_obj(path, &options)
+        .map_err(|e| format!("a Wavefront OBJ file ({}: {e})", path.display()))?;
+    let mut triangles = Vec::new();
+    for model in &models {
+        let positions = &model.mesh.positions;
+        if let Some(bad) = positions.iter().find(|v| !v.is_finite()) {
+            return Err(format!(
+                "finite vertex positions (model `{}` has {bad})",
+                model.name
+            ));
+        }
+        let vertex = |i: u32| {
+            let at = 3 * i as usize;
+            positions
+                .get(at..at + 3)
+                .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
+                .ok_or_else(|| {
+                    format!(
+                        "faces that refer to the {} vertices (model `{}` refers to vertex {})",
+                        positions.len() / 3,
+                        model.name,
+                        i as u64 + 1
+                    )
+                })
+        };
+        for face in model.mesh.indices.chunks_exact(3) {
+            triangles.push([vertex(face[0])?, vertex(face[1])?, vertex(face[2])?]);
+        }
+    }
+    if triangles.is_empty() {
+        return Err(format!(
+            "a mesh with at least one face ({} has none)",
+            path.display()
+        ));
+    }
+    Ok(triangles)
+}
