@@ -16,7 +16,9 @@ use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 
 use super::description::{ObjectFile, ShapeKind};
-use super::mesh::ModelTriangle;
+
+/// A triangle's three vertices in model space.
+pub type ModelTriangle = [[f64; 3]; 3];
 
 /// A rigid placement: scale, then rotation about y, then translation.
 #[derive(Debug, Clone, Copy)]
@@ -70,7 +72,7 @@ impl Placement {
 }
 
 /// The model-space triangles of a built-in shape; `None` for an `obj`
-/// shape, whose triangles come from its file ([`super::mesh`]).
+/// shape, whose triangles come from its file (`super::mesh`).
 pub fn shape_triangles(shape: ShapeKind, subdivisions: u32) -> Option<Vec<ModelTriangle>> {
     Some(match shape {
         ShapeKind::Obj => return None,

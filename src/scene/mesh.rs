@@ -6,10 +6,7 @@
 use std::path::Path;
 
 use super::description::{ObjectFile, SceneError};
-use super::geometry::shape_triangles;
-
-/// A triangle's three vertices in model space.
-pub type ModelTriangle = [[f64; 3]; 3];
+use super::geometry::{ModelTriangle, shape_triangles};
 
 /// An upper bound on the bytes a mesh takes per byte of its OBJ text: a
 /// face line of 8 bytes (`f 1 2 3`) becomes a 72-byte f64 triangle, tobj's
