@@ -367,12 +367,15 @@ impl NufftPlan {
                 slab.resize(layout.height * layout.row_len, 0.0);
                 let (range, origin) = (starts[g]..starts[g + 1], layout.origin(g));
                 let x = &coords[range.start * d..range.end * d];
+                let job = SlabJob {
+                    coords: x,
+                    strengths: strengths.map(|_| &sorted_strengths[range]),
+                    layout: &layout,
+                    origin,
+                };
                 with_width!(self.width, W => match strengths {
-                    None => self.spread_slab_fastest::<W, 1>(x, None, &layout, origin, slab),
-                    Some(_) => {
-                        let c = &sorted_strengths[range];
-                        self.spread_slab_fastest::<W, 2>(x, Some(c), &layout, origin, slab)
-                    }
+                    None => self.spread_slab_fastest::<W, 1>(&job, slab),
+                    Some(_) => self.spread_slab_fastest::<W, 2>(&job, slab),
                 });
             });
         let slabs = &scratch.slabs;
@@ -409,51 +412,34 @@ impl NufftPlan {
     /// same operations in the same order either way, never fused into FMAs
     /// (Rust does not contract a·b + c), so the bits do not depend on the
     /// processor.
-    fn spread_slab_fastest<const W: usize, const C: usize>(
-        &self,
-        coords: &[f64],
-        strengths: Option<&[Complex64]>,
-        layout: &SlabLayout,
-        origin: i64,
-        slab: &mut [f64],
-    ) {
+    fn spread_slab_fastest<const W: usize, const C: usize>(&self, job: &SlabJob, slab: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the processor supports AVX2, checked just above.
-            unsafe { self.spread_slab_avx2::<W, C>(coords, strengths, layout, origin, slab) };
+            unsafe { self.spread_slab_avx2::<W, C>(job, slab) };
             return;
         }
-        self.spread_slab::<W, C>(coords, strengths, layout, origin, slab)
+        self.spread_slab::<W, C>(job, slab)
     }
 
     /// [`Self::spread_slab`] with AVX2 enabled.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn spread_slab_avx2<const W: usize, const C: usize>(
-        &self,
-        coords: &[f64],
-        strengths: Option<&[Complex64]>,
-        layout: &SlabLayout,
-        origin: i64,
-        slab: &mut [f64],
-    ) {
-        self.spread_slab::<W, C>(coords, strengths, layout, origin, slab)
+    fn spread_slab_avx2<const W: usize, const C: usize>(&self, job: &SlabJob, slab: &mut [f64]) {
+        self.spread_slab::<W, C>(job, slab)
     }
 
-    /// Adds the kernels of the points `coords` (d per point), times their
-    /// `strengths` (1 when `None`), to a slab of `layout` whose last axis
-    /// starts at row `origin`. `W` is the kernel width and `C` the values per cell (1 real,
-    /// 2 complex): constants, so every loop over a kernel row has a fixed
-    /// length.
+    /// Adds the kernels of the job's points to its slab. `W` is the kernel
+    /// width and `C` the values per cell (1 real, 2 complex): constants, so
+    /// every loop over a kernel row has a fixed length.
     #[inline(always)]
-    fn spread_slab<const W: usize, const C: usize>(
-        &self,
-        coords: &[f64],
-        strengths: Option<&[Complex64]>,
-        layout: &SlabLayout,
-        origin: i64,
-        slab: &mut [f64],
-    ) {
+    fn spread_slab<const W: usize, const C: usize>(&self, job: &SlabJob, slab: &mut [f64]) {
+        let SlabJob {
+            coords,
+            strengths,
+            layout,
+            origin,
+        } = *job;
         let (n, d) = (self.grid as i64, self.freqs.dim);
         for (j, x) in coords.chunks_exact(d).enumerate() {
             let (mut weights, mut first) = ([[0.0f64; W]; 4], [0i64; 4]);
@@ -944,6 +930,17 @@ fn gather_sorted(
         sorted_strengths.clear();
         sorted_strengths.par_extend(order.par_iter().map(|&j| s[j]));
     }
+}
+
+/// One slab's share of the spreading: the points `coords` (d per point, in
+/// bin order), their `strengths` (1 when `None`), the slabs' `layout` and
+/// the grid row (unwrapped) of this slab's first row.
+#[derive(Clone, Copy)]
+struct SlabJob<'a> {
+    coords: &'a [f64],
+    strengths: Option<&'a [Complex64]>,
+    layout: &'a SlabLayout,
+    origin: i64,
 }
 
 /// Adds a padded slab line (`pad` cells before the grid's first, the rest
