@@ -6,7 +6,7 @@ use varspec::PointSet;
 use varspec::registry;
 use varspec::rng::{set_rng, uniform};
 use varspec::spectrum::dft::{evaluate_series, sample_spectrum};
-use varspec::spectrum::{FrequencyBox, Method, NufftPlan, Sign, expected_power};
+use varspec::spectrum::{FrequencyBox, Method, NufftPlan, Sign, Upsampling, expected_power};
 
 fn draw(name: &str, n: usize, d: usize, seed: u64) -> PointSet {
     registry::build(name, n, Some(d), &[])
@@ -17,6 +17,23 @@ fn draw(name: &str, n: usize, d: usize, seed: u64) -> PointSet {
 
 fn zero() -> Complex64 {
     Complex64::new(0.0, 0.0)
+}
+
+/// Plans on `b` at each tolerance with σ = 2, and with σ = 5/4 where it
+/// reaches the tolerance: (tolerance, description, plan).
+fn plans(b: FrequencyBox, tolerances: &[f64]) -> Vec<(f64, String, NufftPlan)> {
+    let mut out = Vec::new();
+    for &tol in tolerances {
+        for up in [Upsampling::Two, Upsampling::FiveFourths] {
+            if up == Upsampling::FiveFourths && tol < Upsampling::FIVE_FOURTHS_MIN_TOLERANCE {
+                continue;
+            }
+            let plan = NufftPlan::with_upsampling(b, tol, up).unwrap();
+            let what = format!("tol={tol:e} sigma={}", plan.upsampling());
+            out.push((tol, what, plan));
+        }
+    }
+    out
 }
 
 /// max_i |a_i − b_i|.
@@ -44,8 +61,7 @@ fn type1_matches_direct_within_its_tolerance() {
         let p = draw(name, n, d, 3);
         let b = FrequencyBox { dim: d, half };
         let exact = sample_spectrum(&p, &b);
-        for tol in [1e-3, 1e-6, 1e-9, 1e-12] {
-            let plan = NufftPlan::new(b, tol).unwrap();
+        for (tol, what, plan) in plans(b, &[1e-3, 1e-6, 1e-9, 1e-12]) {
             let mut fast = vec![zero(); b.len()];
             plan.type1(
                 &p,
@@ -58,14 +74,14 @@ fn type1_matches_direct_within_its_tolerance() {
             for (f, e) in fast.iter().zip(&exact) {
                 assert!(
                     (f - e).norm() <= bound,
-                    "{name} d={d} tol={tol:e}: |dS| = {} > eps*N = {bound}",
+                    "{name} d={d} {what}: |dS| = {} > eps*N = {bound}",
                     (f - e).norm()
                 );
                 let dp = (f.norm_sqr() - e.norm_sqr()).abs() / n as f64;
                 let power_bound = (2.0 * e.norm() * bound + bound * bound) / n as f64;
                 assert!(
                     dp <= power_bound * (1.0 + 1e-9) + 1e-12,
-                    "{name}: power error {dp} > {power_bound}"
+                    "{name} {what}: power error {dp} > {power_bound}"
                 );
             }
         }
@@ -109,8 +125,7 @@ fn type1_with_strengths_matches_direct_sums() {
                     .sum()
             })
             .collect();
-        for tol in [1e-4, 1e-9, 1e-12] {
-            let plan = NufftPlan::new(b, tol).unwrap();
+        for (tol, what, plan) in plans(b, &[1e-4, 1e-9, 1e-12]) {
             let mut fast = vec![zero(); b.len()];
             plan.type1(
                 &p,
@@ -122,7 +137,7 @@ fn type1_with_strengths_matches_direct_sums() {
             let worst = max_difference(&fast, &exact);
             assert!(
                 worst <= tol * l1,
-                "d={d} half={half} tol={tol:e}: |dF| = {worst:e} > eps*sum|c| = {:e}",
+                "d={d} half={half} {what}: |dF| = {worst:e} > eps*sum|c| = {:e}",
                 tol * l1
             );
         }
@@ -141,8 +156,7 @@ fn type2_matches_direct_within_its_tolerance() {
             .collect();
         let l1: f64 = coeffs.iter().map(|c| c.norm()).sum();
         let exact = evaluate_series(&p, &b, &coeffs);
-        for tol in [1e-4, 1e-8, 1e-12] {
-            let plan = NufftPlan::new(b, tol).unwrap();
+        for (tol, what, plan) in plans(b, &[1e-4, 1e-8, 1e-12]) {
             let mut fast = vec![zero(); n];
             plan.type2(
                 &p,
@@ -154,7 +168,7 @@ fn type2_matches_direct_within_its_tolerance() {
             let worst = max_difference(&fast, &exact);
             assert!(
                 worst <= tol * l1,
-                "d={d} tol={tol:e}: |dc| = {worst} > eps*sum|F| = {}",
+                "d={d} {what}: |dc| = {worst} > eps*sum|F| = {}",
                 tol * l1
             );
         }

@@ -14,7 +14,7 @@ pub mod radial;
 
 pub use expected::{Method, Spectrum, expected_power, expected_power_with};
 pub use frequencies::FrequencyBox;
-pub use nufft::{NufftPlan, Sign};
+pub use nufft::{NufftPlan, Sign, Upsampling};
 
 /// What is wrong with a spectral request.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

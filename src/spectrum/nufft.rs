@@ -7,13 +7,17 @@
 //! Method (Dutt & Rokhlin 1993; kernel and parameters of Barnett, Magland &
 //! af Klinteberg 2019, "A parallel non-uniform fast Fourier transform library
 //! based on an exponential of semicircle kernel", SIAM J. Sci. Comput. 41(5)):
-//! spread each point onto an oversampled periodic grid (σ = 2, n ≥ 2(2h+1))
-//! with the "exponential of semicircle" kernel
-//! ψ(u) = exp(β(√(1 − (2u/w)²) − 1)) of width w grid points, take a d-D FFT,
-//! and divide each mode by the kernel's Fourier transform ψ̂(k/n) (type 2
-//! runs the same steps backwards). With w = ⌈log10(1/ε)⌉ + 1 and β = 2.30·w
-//! the relative error is about ε (BMK 2019, §3 and Eq. (3.2)): |ΔF(k)| ≲
-//! ε·Σ_j |c_j|.
+//! spread each point onto an oversampled periodic grid (n ≥ σ(2h+1) points
+//! per axis, upsampling factor σ = 2 or 5/4) with the "exponential of
+//! semicircle" kernel ψ(u) = exp(β(√(1 − (2u/w)²) − 1)) of width w grid
+//! points, take a d-D FFT, and divide each mode by the kernel's Fourier
+//! transform ψ̂(k/n) (type 2 runs the same steps backwards). With
+//! w = ⌈log10(1/ε)⌉ + 1 and β = 2.30·w at σ = 2, and
+//! w = ⌈ln(1/ε)/(π√(1 − 1/σ))⌉ + 1 and β = 0.97·π·w·(1 − 1/(2σ)) otherwise, the
+//! relative error is about ε (BMK 2019, §3, Eq. (3.2) and §4.3):
+//! |ΔF(k)| ≲ ε·Σ_j |c_j|. σ = 5/4 shrinks the grid (and the FFT) by
+//! (5/8)^d for a wider kernel: [`Upsampling::Auto`] picks the cheaper of the
+//! two from the number of points, as FINUFFT does since version 2.3.
 //!
 //! A plan is a value (docs/architecture.md, "Conventions"): designed once for (d, h, ε), `Send +
 //! Sync`, reused across realizations with caller-supplied scratch.
@@ -109,10 +113,65 @@ pub enum Sign {
     Positive,
 }
 
+/// The upsampling factor σ of the fine grid.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Upsampling {
+    /// σ = 2: the narrowest kernel (every tolerance).
+    Two,
+    /// σ = 5/4: a grid (5/8)^d the size of σ = 2's and a kernel about 1.4
+    /// times wider; tolerances down to 1e-9 (the kernel is at most 16
+    /// points wide).
+    FiveFourths,
+    /// The one of the two with the smaller modelled cost for this many
+    /// points ([`Upsampling::choose`]).
+    Auto {
+        /// Points per transform.
+        points: usize,
+    },
+}
+
+impl Upsampling {
+    /// The smallest tolerance σ = 5/4 reaches with a kernel of at most
+    /// [`MAX_WIDTH`] points.
+    pub const FIVE_FOURTHS_MIN_TOLERANCE: f64 = 1e-9;
+
+    /// σ for `points` points on `freqs` at `tolerance`: the factor whose
+    /// modelled time, N·w^d kernel weights applied plus n^d·log2(n^d) FFT
+    /// work, is smaller. The two cost about the same per unit (fitted to
+    /// `varspec bench spectrum` on 2 cores: 0.6 ns each per thread pair at
+    /// 65,536 and 1,048,576 points on the 512² box, where σ = 5/4 is 1.7×
+    /// faster and 1.27× slower); in 2D at ε = 1e-6 on that box σ = 5/4
+    /// wins below about 300,000 points. A function of its arguments only,
+    /// so the transform is the same for every thread count.
+    pub fn choose(freqs: &FrequencyBox, tolerance: f64, points: usize) -> f64 {
+        if tolerance < Self::FIVE_FOURTHS_MIN_TOLERANCE {
+            return 2.0;
+        }
+        let cost = |sigma: f64| {
+            let (width, _) = kernel_shape(tolerance, sigma);
+            let n = grid_size(freqs.side(), sigma, width) as f64;
+            let cells = n.powi(freqs.dim as i32);
+            let spread = points as f64 * (width as f64).powi(freqs.dim as i32);
+            spread + cells * cells.log2()
+        };
+        if cost(1.25) < cost(2.0) { 1.25 } else { 2.0 }
+    }
+
+    fn sigma(self, freqs: &FrequencyBox, tolerance: f64) -> f64 {
+        match self {
+            Upsampling::Two => 2.0,
+            Upsampling::FiveFourths => 1.25,
+            Upsampling::Auto { points } => Upsampling::choose(freqs, tolerance, points),
+        }
+    }
+}
+
 /// A designed transform for one frequency box and tolerance.
 pub struct NufftPlan {
     freqs: FrequencyBox,
     tolerance: f64,
+    /// Upsampling factor σ (2 or 5/4).
+    sigma: f64,
     /// Fine grid points per axis.
     grid: usize,
     /// Kernel width in grid points.
@@ -146,21 +205,38 @@ pub struct NufftScratch {
 
 impl NufftPlan {
     /// Designs the transform on the box `freqs` with relative tolerance
-    /// `tolerance`.
+    /// `tolerance` and upsampling σ = 2.
     ///
     /// # Errors
     /// [`SpectrumError::Tolerance`] outside [1e-14, 0.1];
     /// [`SpectrumError::UnsupportedDimension`] outside d = 1..=4.
     pub fn new(freqs: FrequencyBox, tolerance: f64) -> Result<Self, SpectrumError> {
+        Self::with_upsampling(freqs, tolerance, Upsampling::Two)
+    }
+
+    /// Designs the transform with the upsampling factor `upsampling`.
+    ///
+    /// # Errors
+    /// As [`NufftPlan::new`]; [`SpectrumError::Tolerance`] also for σ = 5/4
+    /// below [`Upsampling::FIVE_FOURTHS_MIN_TOLERANCE`].
+    pub fn with_upsampling(
+        freqs: FrequencyBox,
+        tolerance: f64,
+        upsampling: Upsampling,
+    ) -> Result<Self, SpectrumError> {
         if !(1..=4).contains(&freqs.dim) {
             return Err(SpectrumError::UnsupportedDimension(freqs.dim));
         }
         if !(1e-14..=0.1).contains(&tolerance) {
             return Err(SpectrumError::Tolerance(tolerance));
         }
+        let sigma = upsampling.sigma(&freqs, tolerance);
+        if sigma < 2.0 && tolerance < Upsampling::FIVE_FOURTHS_MIN_TOLERANCE {
+            return Err(SpectrumError::Tolerance(tolerance));
+        }
         check_nufft_memory(&freqs)?;
-        let (width, beta) = kernel_shape(tolerance);
-        let grid = fine_grid_size(2 * freqs.side()).max(2 * width);
+        let (width, beta) = kernel_shape(tolerance, sigma);
+        let grid = grid_size(freqs.side(), sigma, width);
         let h = freqs.half as i64;
         let rule = crate::quadrature::gauss_legendre(4 * width + 40);
         let correction = (-h..=h)
@@ -175,6 +251,7 @@ impl NufftPlan {
         Ok(NufftPlan {
             freqs,
             tolerance,
+            sigma,
             grid,
             width,
             beta,
@@ -194,6 +271,11 @@ impl NufftPlan {
     /// The requested tolerance ε.
     pub fn tolerance(&self) -> f64 {
         self.tolerance
+    }
+
+    /// The upsampling factor σ in use.
+    pub fn upsampling(&self) -> f64 {
+        self.sigma
     }
 
     /// Fine-grid points per axis.
@@ -1062,11 +1144,27 @@ impl KernelPolynomial {
 /// The widest kernel, in grid points (ε = 1e-14 and below).
 const MAX_WIDTH: usize = 16;
 
-/// Width w = ⌈log10(1/ε)⌉ + 1 grid points (2 to 16) and β = 2.30·w of the
-/// kernel for tolerance ε (BMK 2019, §3 and Eq. (3.2)).
-fn kernel_shape(tolerance: f64) -> (usize, f64) {
-    let width = ((1.0 / tolerance).log10().ceil() as usize + 1).clamp(2, MAX_WIDTH);
-    (width, 2.30 * width as f64)
+/// Width w (2 to 16 grid points) and β of the kernel for tolerance ε and
+/// upsampling σ: w = ⌈log10(1/ε)⌉ + 1 and β = 2.30·w at σ = 2 (BMK 2019, §3
+/// and Eq. (3.2)); w = ⌈ln(1/ε)/(π√(1 − 1/σ))⌉ + 1 and
+/// β = 0.97·π·w·(1 − 1/(2σ)) below (BMK 2019, §4.3, the error estimate
+/// e^(−πw√(1−1/σ)); one point more than that estimate asks, because without
+/// it the error exceeded ε·Σ|c_j| by up to 1.8× against direct sums).
+fn kernel_shape(tolerance: f64, sigma: f64) -> (usize, f64) {
+    if sigma >= 2.0 {
+        let width = ((1.0 / tolerance).log10().ceil() as usize + 1).clamp(2, MAX_WIDTH);
+        return (width, 2.30 * width as f64);
+    }
+    let reach = std::f64::consts::PI * (1.0 - 1.0 / sigma).sqrt();
+    let width = (((1.0 / tolerance).ln() / reach).ceil() as usize + 1).clamp(2, MAX_WIDTH);
+    let beta = 0.97 * std::f64::consts::PI * width as f64 * (1.0 - 0.5 / sigma);
+    (width, beta)
+}
+
+/// Fine-grid points per axis: the smallest fast size at or above σ times
+/// the box's side, and at least two kernel widths.
+fn grid_size(side: usize, sigma: f64, width: usize) -> usize {
+    fine_grid_size((sigma * side as f64).ceil() as usize).max(2 * width)
 }
 
 /// The ES kernel φ(z) = exp(β(√(1 − z²) − 1)) on [−1, 1], 0 outside
@@ -1105,7 +1203,7 @@ pub fn nufft_memory_bytes(freqs: &FrequencyBox) -> Option<f64> {
     let len = freqs.checked_len()?;
     let threads = rayon::current_num_threads() as f64;
     let d = freqs.dim;
-    let n = fine_grid_size(2 * freqs.side()).max(2 * MAX_WIDTH);
+    let n = grid_size(freqs.side(), 2.0, MAX_WIDTH);
     let grid = (n as f64).powi(d as i32) * 16.0;
     Some(threads * (2.0 * grid + SlabLayout::bytes(n, d, MAX_WIDTH)) + len as f64 * 24.0)
 }
@@ -1204,11 +1302,20 @@ mod tests {
     fn the_polynomial_kernel_reaches_every_usual_tolerance() {
         // The fast kernel must not silently fall back to exp/sqrt: for
         // ε = 1e-3 … 1e-12 a low degree fits within ε/4 (checked against φ
-        // at 2001 offsets here independently of the fit's own check).
-        for tol in [1e-3, 1e-6, 1e-9, 1e-12] {
-            let (w, beta) = kernel_shape(tol);
+        // at 2001 offsets here independently of the fit's own check), for
+        // both upsampling factors.
+        let shapes = [1e-3, 1e-6, 1e-9, 1e-12]
+            .map(|tol| (tol, 2.0))
+            .into_iter()
+            .chain([1e-3, 1e-6, 1e-9].map(|tol| (tol, 1.25)));
+        for (tol, sigma) in shapes {
+            let (w, beta) = kernel_shape(tol, sigma);
             let p = KernelPolynomial::fit(w, beta, tol).expect("a polynomial");
-            assert!(p.degree <= w + 3, "tol {tol:e}: degree {}", p.degree);
+            assert!(
+                p.degree <= w + 3,
+                "tol {tol:e} sigma {sigma}: degree {}",
+                p.degree
+            );
             let mut out = vec![0.0; w];
             for i in 0..=2000 {
                 let delta = i as f64 / 2001.0;
@@ -1225,11 +1332,33 @@ mod tests {
     }
 
     #[test]
+    fn auto_upsampling_follows_the_measured_break_even() {
+        // On the 512² box at ε = 1e-6, `varspec bench spectrum` measured
+        // σ = 5/4 1.4× faster at 65,536 points and 1.3× slower at 1,048,576.
+        let b = FrequencyBox::from_resolution(2, 512);
+        assert_eq!(Upsampling::choose(&b, 1e-6, 65_536), 1.25);
+        assert_eq!(Upsampling::choose(&b, 1e-6, 1_048_576), 2.0);
+        // Below 1e-9 only σ = 2 reaches the tolerance.
+        assert_eq!(Upsampling::choose(&b, 1e-12, 1), 2.0);
+    }
+
+    #[test]
     fn bad_tolerances_are_refused() {
         let b = FrequencyBox { dim: 2, half: 4 };
         assert!(NufftPlan::new(b, 0.0).is_err());
         assert!(NufftPlan::new(b, 1e-16).is_err());
         assert!(NufftPlan::new(b, f64::NAN).is_err());
         assert!(NufftPlan::new(b, 1e-6).is_ok());
+        // σ = 5/4 stops at 1e-9 (the kernel would be wider than 16 points).
+        assert!(NufftPlan::with_upsampling(b, 1e-9, Upsampling::FiveFourths).is_ok());
+        assert!(NufftPlan::with_upsampling(b, 1e-10, Upsampling::FiveFourths).is_err());
+        // Auto falls back to σ = 2 there.
+        let auto = Upsampling::Auto { points: 10 };
+        assert_eq!(
+            NufftPlan::with_upsampling(b, 1e-12, auto)
+                .unwrap()
+                .upsampling(),
+            2.0
+        );
     }
 }
