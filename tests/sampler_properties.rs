@@ -177,8 +177,10 @@ proptest! {
 
 #[test]
 fn every_registered_sampler_stays_on_the_torus() {
-    // PointSet::new validates [0,1) and finiteness; this drives every sampler
-    // through it at an awkward N and the extreme PREV_ONE rounding.
+    // Every sampler's set passes through PointSet::new, which refuses a
+    // coordinate outside [0,1) or not finite: `sample` returning Ok (the
+    // unwrap) at an awkward N and 20 seeds is the check; the count is the
+    // sampler's own promise.
     for info in registry::SAMPLERS {
         let d = info.dims.default;
         let (sampler, n) = registry::build_nearest(info.name, 97, Some(d), &[]).unwrap();
@@ -190,11 +192,6 @@ fn every_registered_sampler_stays_on_the_torus() {
             } else {
                 assert_eq!(set.density(), Some(n as f64), "{}", info.name);
             }
-            assert!(
-                set.coords().iter().all(|x| (0.0..1.0).contains(x)),
-                "{}",
-                info.name
-            );
         }
     }
 }

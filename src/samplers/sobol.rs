@@ -227,37 +227,44 @@ mod tests {
         assert_eq!([point(1, 1), point(2, 1), point(3, 1)], [0.5, 0.75, 0.25]);
     }
 
-    /// The t-value of the 2D projection (j, k) of the first 2^m unscrambled
-    /// points: the least t with every elementary interval of volume
-    /// 2^(t−m) holding exactly 2^t points.
-    fn t_value(s: &Sobol, j: usize, k: usize, m: u32) -> u32 {
-        let point = |i: u64, dim: usize| {
-            (0..32)
-                .filter(|b| i >> b & 1 == 1)
-                .fold(0u32, |x, b| x ^ s.directions[dim][b])
-        };
-        let pts: Vec<(u32, u32)> = (0..1u64 << m).map(|i| (point(i, j), point(i, k))).collect();
-        (0..=m)
-            .find(|&t| {
-                (0..=m - t).all(|a| {
-                    let b = m - t - a;
-                    let mut counts = std::collections::HashMap::new();
-                    for &(x, y) in &pts {
-                        *counts
-                            .entry(((x as u64) >> (32 - a), (y as u64) >> (32 - b)))
-                            .or_insert(0u32) += 1;
-                    }
-                    counts.len() == 1 << (a + b) && counts.values().all(|&c| c == 1 << t)
-                })
+    #[test]
+    fn unscrambled_points_equal_an_independent_implementation() {
+        // SciPy's Sobol' generator with the same Joe–Kuo table
+        // (tests/data/sobol-unscrambled-256x21.csv, its header says how it
+        // was made): the first 256 points in all 21 dimensions, compared as
+        // a set because SciPy enumerates them in Gray-code order. A mistyped
+        // polynomial or initial value changes a dimension's points.
+        let text = include_str!("../../tests/data/sobol-unscrambled-256x21.csv");
+        let mut reference: Vec<Vec<u32>> = text
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(reference.len(), 256);
+        let s = Sobol::new(256, MAX_DIM, Scramble::Owen).unwrap();
+        let mut ours: Vec<Vec<u32>> = (0..256u64)
+            .map(|i| {
+                (0..MAX_DIM)
+                    .map(|j| {
+                        (0..32)
+                            .filter(|b| i >> b & 1 == 1)
+                            .fold(0u32, |x, b| x ^ s.directions[j][b])
+                    })
+                    .collect()
             })
-            .expect("t = m always holds")
+            .collect();
+        reference.sort_unstable();
+        ours.sort_unstable();
+        for (j, (r, o)) in reference.iter().zip(&ours).enumerate() {
+            assert_eq!(r, o, "sorted point {j} differs from SciPy's");
+        }
     }
 
     #[test]
-    fn every_dimension_is_a_net_and_pairs_have_small_t() {
-        // Each dimension alone is a (0, m, 1)-net (true for any odd m_k);
-        // pairs of the Joe–Kuo table have small t (their design goal), which
-        // a mistyped polynomial or initial value would break.
+    fn every_dimension_is_a_net_and_the_first_pair_a_zero_net() {
+        // Each dimension alone is a (0, m, 1)-net (true for any odd m_k),
+        // and dimensions 0 and 1 form a (0, m, 2)-net (Sobol' 1967: the
+        // van der Corput sequence with its companion, m_k = 1 and x + 1).
         let m = 10;
         let s = Sobol::new(1 << m, MAX_DIM, Scramble::Owen).unwrap();
         let point = |i: u64, dim: usize| {
@@ -273,22 +280,22 @@ mod tests {
                 "dimension {j} is not a (0, {m}, 1)-net"
             );
         }
-        assert_eq!(
-            t_value(&s, 0, 1, m),
-            0,
-            "dimensions 0 and 1 form a (0, m, 2)-net"
-        );
-        // Bounds from a full scan at m = 10: the first five dimensions pair
-        // with t ≤ 3, all 21 with t ≤ 5.
-        for j in 0..MAX_DIM {
-            for k in j + 1..MAX_DIM {
-                let bound = if k < 5 { 3 } else { 5 };
-                let t = t_value(&s, j, k, m);
-                assert!(
-                    t <= bound,
-                    "dimensions ({j}, {k}) have t = {t} > {bound} at m = {m}"
-                );
-            }
+        // Every elementary interval of area 2^-m, [a/2^i, (a+1)/2^i) ×
+        // [b/2^(m−i), (b+1)/2^(m−i)), holds exactly one point.
+        for i in 0..=m {
+            let mut cells: Vec<u64> = (0..1u64 << m)
+                .map(|p| {
+                    let x = u64::from(point(p, 0)) >> (32 - i);
+                    let y = u64::from(point(p, 1)) >> (32 - (m - i));
+                    (x << (m - i)) | y
+                })
+                .collect();
+            cells.sort_unstable();
+            assert!(
+                cells.iter().enumerate().all(|(c, &v)| v == c as u64),
+                "intervals 2^-{i} x 2^-{} do not hold one point each",
+                m - i
+            );
         }
     }
 
