@@ -366,3 +366,56 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_pixel_as_an_integrand_has_its_closed_form_integral_and_variance() {
+    use std::sync::Arc;
+    use varspec::integrands::Integrand;
+    use varspec::rng::set_rng;
+    use varspec::scene::pixel::{PixelIntegrand, REFERENCE_POINTS};
+    use varspec::variance::empirical;
+    // A defocused edge pixel: f ∈ {0, 1} (albedo 0 or 1, ambient 1), so
+    // I = the closed-form fraction and ∫f² − I² = I(1 − I).
+    let (depth, focus, aperture, edge) = (6.0, 3.0, 0.3, 0.05);
+    let f = PixelIntegrand::new(Arc::new(edge_scene(depth, focus, aperture, edge)), 4, 4);
+    let truth = edge_pixel(depth, focus, aperture, edge, 4);
+    let var_f = truth * (1.0 - truth);
+    assert!(var_f > 0.05, "the edge must cross the pixel: I = {truth}");
+    // The reference set is umj (stratified in (x, y) and (u, v), randomly
+    // paired: at most N/(N−1) times random sampling's variance, Owen 1997):
+    // 6 standard errors of random sampling.
+    let se = (2.0 * var_f / REFERENCE_POINTS as f64).sqrt();
+    assert!(
+        (f.integral() - truth).abs() <= 6.0 * se,
+        "integral {} vs closed form {truth} (6 se = {:.2e})",
+        f.integral(),
+        6.0 * se
+    );
+    assert!(
+        (f.variance() - var_f).abs() <= 6.0 * se + 1e-4,
+        "variance {} vs I(1 − I) = {var_f}",
+        f.variance()
+    );
+    // The empirical predictor on it: random points under a uniform shift
+    // are iid, so Î = Binomial(N, I)/N with variance σ² = I(1 − I)/N and
+    // fourth central moment σ⁴(3 + (1 − 6I(1 − I))/(N·I(1 − I))); the
+    // sample variance of R such Î has standard error √((μ₄ − σ⁴)/R).
+    let (n, r) = (64usize, 20_000usize);
+    let sampler = registry::build("random", n, Some(4), &[]).unwrap();
+    let e = empirical(&f, r, 5, |i| sampler.sample(&mut set_rng(9, i as u64))).unwrap();
+    let sigma2 = var_f / n as f64;
+    let mu4 = sigma2 * sigma2 * (3.0 + (1.0 - 6.0 * var_f) / (n as f64 * var_f));
+    let stderr = ((mu4 - sigma2 * sigma2) / r as f64).sqrt();
+    // 5 standard errors: a two-sided normal tail of 6e-7.
+    assert!(
+        (e.variance - sigma2).abs() <= 5.0 * stderr,
+        "empirical {} vs I(1 − I)/N = {sigma2}: 5 se = {:.2e}",
+        e.variance,
+        5.0 * stderr
+    );
+    assert!(
+        f.fourier(&[1, 0, 0, 0]).re.is_nan(),
+        "no closed-form spectrum"
+    );
+    assert_eq!(f.spec(), "scene:edge,px=4,py=4");
+}

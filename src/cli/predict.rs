@@ -9,7 +9,8 @@ use serde_json::{Value, json};
 
 use super::source::SourceArgs;
 use varspec::PointSet;
-use varspec::integrands;
+use varspec::integrands::{self, Integrand};
+use varspec::scene::pixel::PixelIntegrand;
 use varspec::source::SourceError;
 use varspec::variance::{VarianceError, empirical, fourier_parts, radial_from, spatial};
 
@@ -78,7 +79,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let Some(spec) = &a.integrand else {
         return square(&a);
     };
-    let f = integrands::parse(spec)?;
+    // A scene pixel has no closed form: only the empirical predictor,
+    // which evaluates f, applies (`--method all` runs it alone).
+    let pixel = PixelIntegrand::is_pixel_spec(spec);
+    let f: Box<dyn Integrand> = if pixel {
+        if !matches!(a.method, MethodArg::Empirical | MethodArg::All) {
+            bail!(
+                "{spec}: a scene pixel has no closed-form spectrum or autocovariance; \
+                 predict it with --method empirical"
+            );
+        }
+        Box::new(PixelIntegrand::parse(spec)?)
+    } else {
+        integrands::parse(spec)?
+    };
     if let Some(res) = a.res.filter(|&r| r < 3) {
         bail!(
             "--res {res}: the Fourier box |k| < K/2 needs K >= 3 (K = 3 is the 3^d box around DC)"
@@ -87,7 +101,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let source = a.source.resolve(Some(f.dim()))?;
     let sets = source.count();
     let n = source.points_per_set();
-    let wants = |m: MethodArg| a.method == m || a.method == MethodArg::All;
+    let wants = |m: MethodArg| {
+        a.method == m || (a.method == MethodArg::All && (!pixel || m == MethodArg::Empirical))
+    };
     // The Fourier and spatial forms pass over the same realizations: draw
     // them once (a sampler's draw can be costly, e.g. an optimized set).
     let drawn =
@@ -103,6 +119,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     out.insert("n".into(), json!(n));
     out.insert("density".into(), json!(source.density()));
     out.insert("integral".into(), json!(f.integral()));
+    if pixel {
+        out.insert(
+            "integral_note".into(),
+            json!(format!(
+                "estimated from {} multi-jittered samples (a pixel has no closed form)",
+                varspec::scene::pixel::REFERENCE_POINTS
+            )),
+        );
+    }
     out.insert(
         "estimator".into(),
         json!("shift-randomized: uniform toroidal shift of every dimension"),
@@ -170,10 +195,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "{} on {} ({}, {sets} sets), I = {}",
+        "{} on {} ({}, {sets} sets), I {} {}",
         f.spec(),
         source.name(),
         source.count_label(),
+        if pixel { "≈" } else { "=" },
         f.integral()
     );
     for (key, extra) in [

@@ -9,6 +9,7 @@ pub mod description;
 pub mod geometry;
 pub mod image;
 pub mod mesh;
+pub mod pixel;
 pub mod render;
 
 use camera::Camera;

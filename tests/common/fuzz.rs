@@ -274,6 +274,15 @@ pub fn targets() -> Vec<Target> {
             }),
         },
         Target {
+            name: "scene pixel spec",
+            seeds: lines(&[
+                "scene:dof,px=142,py=64",
+                "scene:shadows-disk,py=3,px=0",
+                "scene:some/file.json,px=1,py=2",
+            ]),
+            run: Box::new(|b| varspec::scene::pixel::PixelIntegrand::parse_spec(&text(b)).is_ok()),
+        },
+        Target {
             name: "square target and family",
             seeds: lines(&[
                 "halfplanes+gaussians+16*blue",

@@ -1,0 +1,206 @@
+//! One pixel of a scene as a 4D integrand, for the analysis tools:
+//! `scene:NAME,px=X,py=Y` (NAME a built-in scene or a scene file).
+//!
+//! f(x, y, u, v) is the pixel's radiance ([`Scene::radiance`]): (x, y) on
+//! the pixel footprint, (u, v) on the lens or the light. It has no closed
+//! form: the empirical predictor, which only evaluates f, applies as is;
+//! the integral and ∫f² − I² are estimates from [`REFERENCE_POINTS`]
+//! multi-jittered samples, and there are no Fourier coefficients or
+//! autocovariance (the closed-form predictors refuse it).
+
+use std::sync::Arc;
+
+use rustfft::num_complex::Complex64;
+
+use super::Scene;
+use super::description::SceneError;
+use crate::integrands::{Integrand, IntegrandClass};
+use crate::rng::set_rng;
+use crate::sum::NeumaierSum;
+
+/// Samples behind the reference integral and variance (umj, 2^16 points:
+/// a few tens of milliseconds of ray tracing).
+pub const REFERENCE_POINTS: usize = 1 << 16;
+
+/// Seed of the reference set.
+const REFERENCE_SEED: u64 = 0x5049_5845_4c52_4546;
+
+/// Pixel (px, py) of a scene as an integrand on [0, 1)^4.
+pub struct PixelIntegrand {
+    scene: Arc<Scene>,
+    px: usize,
+    py: usize,
+    /// Estimated I and ∫f² − I² (from the reference set).
+    integral: f64,
+    variance: f64,
+}
+
+/// What is wrong with a `scene:` spec.
+#[derive(Debug, thiserror::Error)]
+pub enum PixelError {
+    /// Malformed spec.
+    #[error(
+        "`{spec}`: {message} (expected scene:NAME,px=X,py=Y with NAME a built-in scene or a scene file)"
+    )]
+    Syntax {
+        /// The spec.
+        spec: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The scene could not be loaded.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+}
+
+impl PixelIntegrand {
+    /// True for a spec this type parses (`scene:...`).
+    pub fn is_pixel_spec(spec: &str) -> bool {
+        spec.starts_with("scene:")
+    }
+
+    /// Parses `scene:NAME,px=X,py=Y`, loads the scene and computes the
+    /// reference integral.
+    ///
+    /// # Errors
+    /// [`PixelError::Syntax`] for a malformed spec or a pixel outside the
+    /// image; [`PixelError::Scene`] when the scene does not load.
+    pub fn parse(spec: &str) -> Result<PixelIntegrand, PixelError> {
+        let (name, px, py) = Self::parse_spec(spec)?;
+        let scene = Scene::load(name)?;
+        let [w, h] = scene.camera().resolution();
+        if px >= w || py >= h {
+            return Err(PixelError::Syntax {
+                spec: spec.into(),
+                message: format!("pixel ({px}, {py}) is outside the {w}x{h} image of `{name}`"),
+            });
+        }
+        Ok(PixelIntegrand::new(Arc::new(scene), px, py))
+    }
+
+    /// The text of a spec: (scene name, px, py), without loading anything.
+    ///
+    /// # Errors
+    /// [`PixelError::Syntax`] naming what is wrong.
+    pub fn parse_spec(spec: &str) -> Result<(&str, usize, usize), PixelError> {
+        let fail = |message: String| PixelError::Syntax {
+            spec: spec.into(),
+            message,
+        };
+        let rest = spec
+            .strip_prefix("scene:")
+            .ok_or_else(|| fail("no `scene:` prefix".into()))?;
+        let (name, params) = rest
+            .split_once(',')
+            .ok_or_else(|| fail("no pixel given".into()))?;
+        if name.is_empty() {
+            return Err(fail("no scene name".into()));
+        }
+        let (mut px, mut py) = (None, None);
+        for part in params.split(',') {
+            let (key, value) = part
+                .split_once('=')
+                .ok_or_else(|| fail(format!("`{part}` is not key=value")))?;
+            let slot = match key.trim() {
+                "px" => &mut px,
+                "py" => &mut py,
+                other => {
+                    return Err(fail(format!(
+                        "unknown parameter `{other}`; its parameters: px, py"
+                    )));
+                }
+            };
+            if slot.is_some() {
+                return Err(fail(format!("`{key}` given twice")));
+            }
+            let v: usize = value.trim().parse().map_err(|_| {
+                fail(format!(
+                    "{key} = {value}: a pixel index, a whole number >= 0"
+                ))
+            })?;
+            *slot = Some(v);
+        }
+        let (Some(px), Some(py)) = (px, py) else {
+            return Err(fail("both px and py are needed".into()));
+        };
+        Ok((name, px, py))
+    }
+
+    /// Pixel (px, py) of `scene` (inside its image).
+    ///
+    /// # Panics
+    /// If the pixel is outside the image.
+    pub fn new(scene: Arc<Scene>, px: usize, py: usize) -> PixelIntegrand {
+        let [w, h] = scene.camera().resolution();
+        assert!(px < w && py < h, "pixel ({px}, {py}) outside {w}x{h}");
+        let reference = crate::registry::build("umj", REFERENCE_POINTS, Some(4), &[])
+            .and_then(|s| s.sample(&mut set_rng(REFERENCE_SEED, 0)))
+            .expect("umj makes 2^16 4D points");
+        let values: Vec<f64> = reference
+            .points()
+            .map(|p| scene.radiance(px, py, [p[0], p[1], p[2], p[3]]))
+            .collect();
+        let n = values.len() as f64;
+        let mut sum = NeumaierSum::default();
+        values.iter().for_each(|&v| sum.add(v));
+        let integral = sum.value() / n;
+        let mut squares = NeumaierSum::default();
+        values
+            .iter()
+            .for_each(|&v| squares.add((v - integral).powi(2)));
+        PixelIntegrand {
+            scene,
+            px,
+            py,
+            integral,
+            variance: squares.value() / (n - 1.0),
+        }
+    }
+
+    /// The pixel.
+    pub fn pixel(&self) -> [usize; 2] {
+        [self.px, self.py]
+    }
+}
+
+impl Integrand for PixelIntegrand {
+    fn dim(&self) -> usize {
+        4
+    }
+
+    /// An estimate: the mean of f over [`REFERENCE_POINTS`] umj points.
+    fn integral(&self) -> f64 {
+        self.integral
+    }
+
+    /// An estimate: the sample variance of f over the same points.
+    fn variance(&self) -> f64 {
+        self.variance
+    }
+
+    fn eval(&self, x: &[f64]) -> f64 {
+        self.scene
+            .radiance(self.px, self.py, [x[0], x[1], x[2], x[3]])
+    }
+
+    /// Not known: NaN (a pixel has no closed-form spectrum; the Fourier
+    /// predictor and the optimizers' targets refuse pixels before asking).
+    fn fourier(&self, _k: &[i64]) -> Complex64 {
+        Complex64::new(f64::NAN, f64::NAN)
+    }
+
+    fn autocov(&self, _h: &[f64]) -> Option<f64> {
+        None
+    }
+
+    fn class(&self) -> IntegrandClass {
+        IntegrandClass {
+            smooth: false,
+            one_axis: false,
+        }
+    }
+
+    fn spec(&self) -> String {
+        format!("scene:{},px={},py={}", self.scene.name(), self.px, self.py)
+    }
+}
