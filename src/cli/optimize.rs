@@ -761,17 +761,145 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// XU and YV expected spectra (K = 64) of `sets` and `sheared` as
+/// PREFIX-{xu,yv}-{before,after}.png, titled by `what`.
+fn projection_pngs(
+    prefix: &str,
+    what: &str,
+    n: usize,
+    sets: &[varspec::PointSet],
+    sheared: &[varspec::PointSet],
+) -> anyhow::Result<()> {
+    use varspec::report::plot::spectrum_png;
+    use varspec::spectrum::{FrequencyBox, Method, expected_power};
+    let freqs = FrequencyBox::from_resolution(2, 64);
+    for (label, sets) in [("before", sets), ("after", sheared)] {
+        for (name, dims) in [("xu", [0usize, 2]), ("yv", [1, 3])] {
+            let spectrum = expected_power(
+                freqs,
+                Method::Fast { tolerance: 1e-9 },
+                sets.len(),
+                |r| sets[r].projected(&dims).map_err(|e| anyhow::anyhow!(e)),
+                &|| {},
+            )?;
+            let title = format!("{what} N={n} {name} projection, {label} shear");
+            spectrum_png(
+                &spectrum,
+                &title,
+                std::path::Path::new(&format!("{prefix}-{name}-{label}.png")),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+/// `optimize shear` on a scene pixel: the candidates of its local analysis
+/// measured by the render's (unshifted) estimator.
+fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
+    use varspec::integrands::Integrand;
+    use varspec::scene::pixel::PixelIntegrand;
+    use varspec::scene::pixel_shear::{Measured, PixelShearOptions, search_pixel_shear};
+    let f = PixelIntegrand::parse(&a.integrand)?;
+    let sampler = registry::build(&a.sampler, a.n, Some(4), &[])?;
+    let start = Instant::now();
+    let options = PixelShearOptions {
+        seed: a.seed,
+        min_realizations: a.realizations.max(2),
+        ..PixelShearOptions::default()
+    };
+    let found = search_pixel_shear(&f, sampler.as_ref(), options)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let best = found.best();
+    let sets: Vec<_> = (0..a.sets as u64)
+        .map(|r| sampler.sample(&mut set_rng(a.seed, r)))
+        .collect::<Result<_, _>>()?;
+    let sheared: Vec<_> = sets.iter().map(|s| best.shear.apply(s.clone())).collect();
+    if let Some(path) = &a.output {
+        write_atomic(path, |w| write_point_sets(w, &sheared, PointFormat::Csv))?;
+    }
+    if let Some(prefix) = &a.png_prefix {
+        projection_pngs(
+            prefix,
+            &format!("{} {}", a.sampler, f.spec()),
+            a.n,
+            &sets,
+            &sheared,
+        )?;
+    }
+    let row = |m: &Measured| {
+        let e = &m.estimate;
+        json!({"form": m.shear.form(), "amounts": m.shear.amounts(), "variance": e.variance,
+               "stderr": e.stderr, "ci_low": e.ci_low, "ci_high": e.ci_high, "realizations": e.realizations})
+    };
+    let analysis = &found.analysis;
+    let reduction = found.unsheared().estimate.variance / best.estimate.variance;
+    let out = json!({
+        "sampler": a.sampler, "integrand": f.spec(), "n": a.n, "sets": a.sets, "seed": a.seed,
+        "estimator": "unshifted: mean of f over the transformed set (the render's); unbiased for every candidate",
+        "pixel": {"kind": analysis.kind.name(), "depth": analysis.depth, "kappa": analysis.kappa, "kappas": analysis.kappas},
+        "candidates": found.candidates.iter().map(row).collect::<Vec<_>>(),
+        "chosen": row(best), "double_wedge": found.double_wedge, "hairline": found.hairline,
+        "sensitivity": found.sensitivity.as_ref().map(|s| json!({"step": varspec::optimize::shear::SENSITIVITY_STEP, "minus": row(&s[0]), "plus": row(&s[1])})),
+        "reduction": reduction, "seconds": seconds,
+    });
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!(
+        "{} ({} pixel, depth {:.4}, κ {:.4}{}{}) with {} N={}, {} realizations per candidate:",
+        f.spec(),
+        analysis.kind.name(),
+        analysis.depth,
+        analysis.kappa,
+        if found.double_wedge {
+            "; double wedge"
+        } else {
+            ""
+        },
+        if found.hairline { "; hairline" } else { "" },
+        a.sampler,
+        a.n,
+        best.estimate.realizations
+    );
+    for (i, m) in found.candidates.iter().enumerate() {
+        let e = &m.estimate;
+        println!(
+            "  {} {:<8} ({:>8.4}, {:>8.4})  variance {:.4e} ± {:.1e}",
+            if i == found.chosen { "*" } else { " " },
+            m.shear.form(),
+            m.shear.amounts()[0],
+            m.shear.amounts()[1],
+            e.variance,
+            e.stderr
+        );
+    }
+    println!(
+        "chosen: {} ({:.4}, {:.4}), {} than no shear, search {seconds:.2} s",
+        best.shear.form(),
+        best.shear.amounts()[0],
+        best.shear.amounts()[1],
+        if reduction > 1.0 {
+            format!("{reduction:.2}x lower")
+        } else {
+            "no lower".to_string()
+        }
+    );
+    Ok(())
+}
+
 fn shear(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::integrands;
     use varspec::optimize::shear::{
         MAX_SHEAR_RANGE, ObjectiveOptions, SENSITIVITY_STEP, ShearObjective, Sheared, search_shear,
         shear_set, spectral_start,
     };
-    use varspec::report::plot::spectrum_png;
     use varspec::samplers::Sampler;
-    use varspec::spectrum::{FrequencyBox, Method, expected_power};
     use varspec::variance::{VarianceError, empirical_shifting};
     args::check_outputs([a.output.as_deref()])?;
+    if varspec::scene::pixel::PixelIntegrand::is_pixel_spec(&a.integrand) {
+        return shear_pixel(a);
+    }
 
     let f = integrands::parse(&a.integrand)?;
     if f.dim() != 4 {
@@ -843,29 +971,13 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         write_atomic(path, |w| write_point_sets(w, &sheared, PointFormat::Csv))?;
     }
     if let Some(prefix) = &a.png_prefix {
-        let freqs = FrequencyBox::from_resolution(2, 64);
-        for (label, sets) in [("before", &sets), ("after", &sheared)] {
-            for (name, dims) in [("xu", [0usize, 2]), ("yv", [1, 3])] {
-                let spectrum = expected_power(
-                    freqs,
-                    Method::Fast { tolerance: 1e-9 },
-                    sets.len(),
-                    |r| sets[r].projected(&dims).map_err(|e| anyhow::anyhow!(e)),
-                    &|| {},
-                )?;
-                let title = format!(
-                    "{} {} N={} {name} projection, {label} shear",
-                    a.sampler,
-                    f.spec(),
-                    a.n
-                );
-                spectrum_png(
-                    &spectrum,
-                    &title,
-                    std::path::Path::new(&format!("{prefix}-{name}-{label}.png")),
-                )?;
-            }
-        }
+        projection_pngs(
+            prefix,
+            &format!("{} {}", a.sampler, f.spec()),
+            a.n,
+            &sets,
+            &sheared,
+        )?;
     }
     let analytic = f.light_field().map(|l| l.layer_shears());
     let relative_stderr = found.optimum.stderr / found.optimum.value;

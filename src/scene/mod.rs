@@ -10,6 +10,7 @@ pub mod geometry;
 pub mod image;
 pub mod mesh;
 pub mod pixel;
+pub mod pixel_shear;
 pub mod render;
 
 use camera::Camera;

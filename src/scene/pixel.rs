@@ -161,6 +161,11 @@ impl PixelIntegrand {
     pub fn pixel(&self) -> [usize; 2] {
         [self.px, self.py]
     }
+
+    /// The scene.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
 }
 
 impl Integrand for PixelIntegrand {
