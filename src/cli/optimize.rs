@@ -761,6 +761,10 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The XU and YV planes of a 4D set: name, coordinates, frequency axes.
+const PLANES: [(&str, [usize; 2], [&str; 2]); 2] =
+    [("xu", [0, 2], ["kx", "ku"]), ("yv", [1, 3], ["ky", "kv"])];
+
 /// XU and YV expected spectra (K = 64) of `sets` and `sheared` as
 /// PREFIX-{xu,yv}-{before,after}.png, titled by `what`.
 fn projection_pngs(
@@ -770,11 +774,11 @@ fn projection_pngs(
     sets: &[varspec::PointSet],
     sheared: &[varspec::PointSet],
 ) -> anyhow::Result<()> {
-    use varspec::report::plot::spectrum_png;
+    use varspec::report::plot::power_png;
     use varspec::spectrum::{FrequencyBox, Method, expected_power};
     let freqs = FrequencyBox::from_resolution(2, 64);
     for (label, sets) in [("before", sets), ("after", sheared)] {
-        for (name, dims) in [("xu", [0usize, 2]), ("yv", [1, 3])] {
+        for (name, dims, axes) in PLANES {
             let spectrum = expected_power(
                 freqs,
                 Method::Fast { tolerance: 1e-9 },
@@ -783,9 +787,11 @@ fn projection_pngs(
                 &|| {},
             )?;
             let title = format!("{what} N={n} {name} projection, {label} shear");
-            spectrum_png(
+            power_png(
                 &spectrum,
                 &title,
+                axes,
+                "log10 power (N·P_S)",
                 std::path::Path::new(&format!("{prefix}-{name}-{label}.png")),
             )?;
         }
@@ -825,6 +831,18 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
             &sets,
             &sheared,
         )?;
+        // The pixel's own light-field power on the same planes: where the
+        // sets' dark regions should lie.
+        for (name, dims, axes) in PLANES {
+            let power = f.plane_power(dims, 128, 16, a.seed)?;
+            varspec::report::plot::power_png(
+                &power,
+                &format!("{} light field, {name} plane", f.spec()),
+                axes,
+                "log10 |F_f(k)|^2",
+                std::path::Path::new(&format!("{prefix}-f-{name}.png")),
+            )?;
+        }
     }
     let row = |m: &Measured| {
         let e = &m.estimate;

@@ -241,6 +241,22 @@ pub struct HeatMap<'a> {
 /// [`Error::Write`] naming `path`; a spectrum that is not 2D is refused the
 /// same way.
 pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(), Error> {
+    power_png(spectrum, title, ["kx", "ky"], "log10 power (N·P_S)", path)
+}
+
+/// As [`spectrum_png`] with the two frequency axes named `axes` (e.g.
+/// `["kx", "ku"]` for an XU projection) and the colour bar `bar_label` (the
+/// power of a sample set or of an integrand).
+///
+/// # Errors
+/// As [`spectrum_png`].
+pub fn power_png(
+    spectrum: &Spectrum,
+    title: &str,
+    axes: [&str; 2],
+    bar_label: &str,
+    path: &Path,
+) -> Result<(), Error> {
     if spectrum.freqs.dim != 2 {
         return Err(Error::Write(WriteError {
             path: path.to_path_buf(),
@@ -279,9 +295,9 @@ pub fn spectrum_png(spectrum: &Spectrum, title: &str, path: &Path) -> Result<(),
             width: side,
             x_range: (-h - 0.5, h + 0.5),
             y_range: (-h - 0.5, h + 0.5),
-            x_label: "kx".into(),
-            y_label: "ky".into(),
-            bar_label: "log10 power (N·P_S)".into(),
+            x_label: axes[0].into(),
+            y_label: axes[1].into(),
+            bar_label: bar_label.into(),
             colour_range: (lo, hi),
         },
         path,

@@ -53,4 +53,7 @@ pub enum SpectrumError {
     /// A bad pair-correlation parameter.
     #[error("pair correlation: {0}")]
     Pcf(String),
+    /// A bad plane or grid for a light field's plane spectrum.
+    #[error("light-field plane spectrum: {0}")]
+    Plane(String),
 }
