@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
 
-use super::nufft::{NufftPlan, Sign};
+use super::nufft::{NufftPlan, Sign, Upsampling};
 use super::{FrequencyBox, SpectrumError, dft};
 use crate::points::PointSet;
 
@@ -17,7 +17,9 @@ const CHUNK: usize = 8;
 pub enum Method {
     /// Exact direct sums (the reference), O(N·K^d).
     Direct,
-    /// Type-1 non-uniform FFT with relative tolerance ε, O(N·w^d + K^d log K).
+    /// Type-1 non-uniform FFT with relative tolerance ε, O(N·w^d + K^d log K),
+    /// its upsampling chosen for the first realization's size
+    /// ([`Upsampling::Auto`]).
     Fast {
         /// ε in [1e-14, 0.1].
         tolerance: f64,
@@ -117,8 +119,17 @@ where
     if sets == 0 {
         return Err(SpectrumError::NoSets.into());
     }
+    // The first realization is drawn up front: its size picks the
+    // transform's upsampling (the same choice for any thread count).
+    let first = realization(0)?;
     let plan = match method {
-        Method::Fast { tolerance } => Some(NufftPlan::new(freqs, tolerance)?),
+        Method::Fast { tolerance } => Some(NufftPlan::with_upsampling(
+            freqs,
+            tolerance,
+            Upsampling::Auto {
+                points: first.len(),
+            },
+        )?),
         Method::Direct => None,
     };
     let len = freqs.len();
@@ -137,7 +148,11 @@ where
                 let mut sum = vec![0.0; len];
                 let mut stats = Vec::with_capacity(CHUNK);
                 for r in c * CHUNK..((c + 1) * CHUNK).min(sets) {
-                    let points = realization(r)?;
+                    let points = if r == 0 {
+                        first.clone()
+                    } else {
+                        realization(r)?
+                    };
                     if points.dim() != freqs.dim {
                         return Err(SpectrumError::Dimension {
                             expected: freqs.dim,
