@@ -124,7 +124,7 @@ pub struct PointsArgs {
     /// The non-uniform FFT's upsampling factor σ: the fine grid has σ times
     /// the box's side per axis. `1.25` shrinks the FFT (2.6× in 2D) for a
     /// wider kernel (reaches --tol down to 1e-9); `auto` picks the faster
-    /// for this N (1.25 below about 300,000 points in 2D).
+    /// for this N (1.25 below about 200,000 points in 2D).
     #[arg(long, value_enum, default_value_t = UpsamplingArg::Auto)]
     upsampling: UpsamplingArg,
     /// Output point-set file (CSV).
@@ -799,6 +799,34 @@ fn projection_pngs(
     Ok(())
 }
 
+/// The `--sets` sets of `optimize shear` (seeded by `--seed`) transformed
+/// by `transform`, written with `-o`, and their XU/YV spectra before and
+/// after with `--png-prefix`.
+fn sheared_outputs(
+    a: &ShearArgs,
+    spec: &str,
+    sampler: &dyn varspec::samplers::Sampler,
+    transform: impl Fn(&varspec::PointSet) -> anyhow::Result<varspec::PointSet>,
+) -> anyhow::Result<()> {
+    let sets: Vec<_> = (0..a.sets as u64)
+        .map(|r| sampler.sample(&mut set_rng(a.seed, r)))
+        .collect::<Result<_, _>>()?;
+    let sheared: Vec<_> = sets.iter().map(transform).collect::<Result<_, _>>()?;
+    if let Some(path) = &a.output {
+        write_atomic(path, |w| write_point_sets(w, &sheared, PointFormat::Csv))?;
+    }
+    if let Some(prefix) = &a.png_prefix {
+        projection_pngs(
+            prefix,
+            &format!("{} {spec}", a.sampler),
+            a.n,
+            &sets,
+            &sheared,
+        )?;
+    }
+    Ok(())
+}
+
 /// `optimize shear` on a scene pixel: the candidates of its local analysis
 /// measured by the render's (unshifted) estimator.
 fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
@@ -816,21 +844,10 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
     let found = search_pixel_shear(&f, sampler.as_ref(), options)?;
     let seconds = start.elapsed().as_secs_f64();
     let best = found.best();
-    let sets: Vec<_> = (0..a.sets as u64)
-        .map(|r| sampler.sample(&mut set_rng(a.seed, r)))
-        .collect::<Result<_, _>>()?;
-    let sheared: Vec<_> = sets.iter().map(|s| best.shear.apply(s.clone())).collect();
-    if let Some(path) = &a.output {
-        write_atomic(path, |w| write_point_sets(w, &sheared, PointFormat::Csv))?;
-    }
+    sheared_outputs(&a, &f.spec(), sampler.as_ref(), |s| {
+        Ok(best.shear.apply(s.clone()))
+    })?;
     if let Some(prefix) = &a.png_prefix {
-        projection_pngs(
-            prefix,
-            &format!("{} {}", a.sampler, f.spec()),
-            a.n,
-            &sets,
-            &sheared,
-        )?;
         // The pixel's own light-field power on the same planes: where the
         // sets' dark regions should lie.
         for (name, dims, axes) in PLANES {
@@ -978,25 +995,9 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     } else {
         None
     };
-    let sets: Vec<_> = (0..a.sets as u64)
-        .map(|r| sampler.sample(&mut set_rng(a.seed, r)))
-        .collect::<Result<_, _>>()?;
-    let sheared: Vec<_> = sets
-        .iter()
-        .map(|s| shear_set(s, found.shear))
-        .collect::<Result<_, _>>()?;
-    if let Some(path) = &a.output {
-        write_atomic(path, |w| write_point_sets(w, &sheared, PointFormat::Csv))?;
-    }
-    if let Some(prefix) = &a.png_prefix {
-        projection_pngs(
-            prefix,
-            &format!("{} {}", a.sampler, f.spec()),
-            a.n,
-            &sets,
-            &sheared,
-        )?;
-    }
+    sheared_outputs(&a, &f.spec(), sampler.as_ref(), |s| {
+        Ok(shear_set(s, found.shear)?)
+    })?;
     let analytic = f.light_field().map(|l| l.layer_shears());
     let relative_stderr = found.optimum.stderr / found.optimum.value;
     let plane = |p: &varspec::optimize::shear::PlaneDirections| {

@@ -49,8 +49,8 @@ pub struct DescentOptions {
     /// 1.02×), so it is an option, not the default.
     pub coarse_half: Option<usize>,
     /// The NUFFT's upsampling factor: [`Upsampling::Auto`] for the set's
-    /// size by default (σ = 5/4 below about 300,000 points in 2D, where it
-    /// makes a step at N = 65,536 1.6× faster; spectrum/nufft.rs).
+    /// size by default (σ = 5/4 below about 200,000 points in 2D, where it
+    /// makes a step at N = 65,536 1.4–1.5× faster; spectrum/nufft.rs).
     pub upsampling: Upsampling,
 }
 

@@ -138,11 +138,11 @@ impl Upsampling {
     /// σ for `points` points on `freqs` at `tolerance`: the factor whose
     /// modelled time, N·w^d kernel weights applied plus n^d·log2(n^d) FFT
     /// work, is smaller. The two cost about the same per unit (fitted to
-    /// `varspec bench spectrum` on 2 cores: 0.6 ns each per thread pair at
-    /// 65,536 and 1,048,576 points on the 512² box, where σ = 5/4 is 1.7×
-    /// faster and 1.27× slower); in 2D at ε = 1e-6 on that box σ = 5/4
-    /// wins below about 300,000 points. A function of its arguments only,
-    /// so the transform is the same for every thread count.
+    /// `varspec bench spectrum` on 2 cores, about 0.3 ns each at 65,536 and
+    /// 1,048,576 points on the 512² box, where σ = 5/4 is 1.3–1.4× faster
+    /// and 1.1–1.4× slower); in 2D at ε = 1e-6 on that box σ = 5/4 wins
+    /// below about 200,000 points. A function of its arguments only, so the
+    /// transform is the same for every thread count.
     pub fn choose(freqs: &FrequencyBox, tolerance: f64, points: usize) -> f64 {
         if tolerance < Self::FIVE_FOURTHS_MIN_TOLERANCE {
             return 2.0;
