@@ -417,6 +417,17 @@ fn a_pixel_as_an_integrand_has_its_closed_form_integral_and_variance() {
         f.fourier(&[1, 0, 0, 0]).re.is_nan(),
         "no closed-form spectrum"
     );
+    // ... so the Fourier predictor refuses it instead of summing NaN.
+    let refused = varspec::variance::fourier(&f, 4, 1e-9, 2, |i| {
+        sampler.sample(&mut set_rng(9, i as u64))
+    });
+    assert!(
+        matches!(
+            refused,
+            Err(varspec::variance::VarianceError::NoFourier { .. })
+        ),
+        "{refused:?}"
+    );
     assert_eq!(f.spec(), "scene:edge,px=4,py=4");
 }
 

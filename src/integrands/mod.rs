@@ -42,6 +42,12 @@ pub trait Integrand: Send + Sync {
     fn eval(&self, x: &[f64]) -> f64;
     /// The Fourier coefficient F_f(k) = ∫ f(x) e^(−2πik·x) dx.
     fn fourier(&self, k: &[i64]) -> Complex64;
+    /// False when [`Integrand::fourier`] has no closed form (it then
+    /// returns NaN), e.g. a scene pixel: the Fourier predictors refuse such
+    /// an integrand instead of summing NaN.
+    fn has_fourier(&self) -> bool {
+        true
+    }
     /// The periodic autocovariance c_f(h), or `None` where no closed form is
     /// implemented (4D integrands).
     fn autocov(&self, h: &[f64]) -> Option<f64>;

@@ -269,10 +269,15 @@ impl Integrand for PixelIntegrand {
             .radiance(self.px, self.py, [x[0], x[1], x[2], x[3]])
     }
 
-    /// Not known: NaN (a pixel has no closed-form spectrum; the Fourier
-    /// predictor and the optimizers' targets refuse pixels before asking).
+    /// Not known: NaN (a pixel has no closed-form spectrum; see
+    /// [`Self::plane_power`] for a measured one).
     fn fourier(&self, _k: &[i64]) -> Complex64 {
         Complex64::new(f64::NAN, f64::NAN)
+    }
+
+    /// False: the Fourier predictors refuse a pixel.
+    fn has_fourier(&self) -> bool {
+        false
     }
 
     fn autocov(&self, _h: &[f64]) -> Option<f64> {

@@ -81,8 +81,9 @@ pub fn integrand_power(f: &dyn Integrand, freqs: &FrequencyBox) -> Vec<f64> {
 /// power of `sets` realizations (fast spectrum at tolerance `tolerance`).
 ///
 /// # Errors
-/// [`VarianceError`] for a dimension mismatch, sets of different N, or a
-/// failing realization or spectrum.
+/// [`VarianceError`] for a dimension mismatch, sets of different N, a
+/// failing realization or spectrum, or an integrand without Fourier
+/// coefficients ([`VarianceError::NoFourier`]).
 pub fn fourier<E>(
     f: &dyn Integrand,
     half: usize,
@@ -126,6 +127,9 @@ where
     VarianceError: From<E>,
     E: Send,
 {
+    if !f.has_fourier() {
+        return Err(VarianceError::NoFourier { spec: f.spec() });
+    }
     let freqs = FrequencyBox { dim: f.dim(), half };
     // P_f, the expected power and the transform all live on the box: check
     // it fits before drawing anything.

@@ -44,6 +44,14 @@ pub enum VarianceError {
         /// The integrand.
         spec: String,
     },
+    /// The Fourier forms need the integrand's Fourier coefficients.
+    #[error(
+        "the Fourier predictor needs the integrand's Fourier coefficients, which {spec} does not have in closed form (use the empirical predictor)"
+    )]
+    NoFourier {
+        /// The integrand.
+        spec: String,
+    },
     /// Realizations of different sizes in a Fourier prediction.
     #[error(
         "the Fourier predictor needs every set to have the same N (found {first} and {other}), \
