@@ -18,7 +18,7 @@ use crate::integrands::{Integrand, IntegrandClass};
 use crate::points::PointSet;
 use crate::rng::{set_rng, uniform};
 use crate::spectrum::{FrequencyBox, NufftPlan, Sign, Spectrum, SpectrumError};
-use crate::sum::NeumaierSum;
+use crate::sum::{NeumaierSum, sum};
 
 /// Samples behind the reference integral and variance (umj, 2^16 points:
 /// a few tens of milliseconds of ray tracing).
@@ -143,19 +143,14 @@ impl PixelIntegrand {
             .map(|p| scene.radiance(px, py, [p[0], p[1], p[2], p[3]]))
             .collect();
         let n = values.len() as f64;
-        let mut sum = NeumaierSum::default();
-        values.iter().for_each(|&v| sum.add(v));
-        let integral = sum.value() / n;
-        let mut squares = NeumaierSum::default();
-        values
-            .iter()
-            .for_each(|&v| squares.add((v - integral).powi(2)));
+        let integral = sum(values.iter().copied()) / n;
+        let squares = sum(values.iter().map(|v| (v - integral).powi(2)));
         PixelIntegrand {
             scene,
             px,
             py,
             integral,
-            variance: squares.value() / (n - 1.0),
+            variance: squares / (n - 1.0),
         }
     }
 
