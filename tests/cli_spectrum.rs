@@ -199,3 +199,87 @@ fn spectrum_output_does_not_depend_on_thread_count() {
     let run = |threads| varspec_with(&args, Some(threads)).stdout;
     assert_eq!(run("1"), run("2"));
 }
+
+/// Reads `kx,ky,power` rows into a map from (kx, ky) to power.
+fn power_map(path: &Path) -> std::collections::HashMap<(i64, i64), f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("kx,ky,power"));
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (
+                (f[0].parse().unwrap(), f[1].parse().unwrap()),
+                f[2].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// |∫_0^w e^(−2πikx) dx|² = (sin(πkw)/(πk))², w² at k = 0.
+fn interval_power(k: i64, w: f64) -> f64 {
+    if k == 0 {
+        w * w
+    } else {
+        let a = std::f64::consts::PI * k as f64;
+        ((a * w).sin() / a).powi(2)
+    }
+}
+
+#[test]
+fn an_integrands_power_is_its_closed_form_and_a_4d_one_is_drawn_on_a_plane() {
+    let dir = temp_dir("integrand-power");
+    // A 2D box: P_f(k) is the product of the two intervals' powers.
+    let rect = dir.join("rect.csv");
+    ok(&varspec(&[
+        "spectrum",
+        "--integrand",
+        "box:w=0.3,h=0.2",
+        "--res",
+        "17",
+        "--csv",
+        s(&rect),
+    ]));
+    let p = power_map(&rect);
+    assert_eq!(p.len(), 17 * 17);
+    for ((kx, ky), power) in &p {
+        let want = interval_power(*kx, 0.3) * interval_power(*ky, 0.2);
+        assert!(
+            (power - want).abs() <= 1e-12 * want.max(1e-6),
+            "box at ({kx}, {ky}): {power} against {want}"
+        );
+    }
+    // Defocus with c = 1/2 on the XU plane: the marginal over (y, v) has
+    // its energy on k_u = c·k_x (the seed's sheared line) and none at
+    // (2, −1), where sinc(π(k_u − c·k_x)) = sinc(−2π) = 0.
+    let xu = dir.join("xu.csv");
+    ok(&varspec(&[
+        "spectrum",
+        "--integrand",
+        "defocus:shape=box,size=0.3,c=0.5",
+        "--dims",
+        "0,2",
+        "--res",
+        "9",
+        "--csv",
+        s(&xu),
+    ]));
+    let p = power_map(&xu);
+    let on_line = interval_power(2, 0.3) * 0.3 * 0.3;
+    assert!(
+        (p[&(2, 1)] - on_line).abs() <= 1e-12 * on_line,
+        "(2, 1): {} against {on_line}",
+        p[&(2, 1)]
+    );
+    assert!(p[&(2, -1)] <= 1e-30, "(2, -1): {}", p[&(2, -1)]);
+    // Refusals name the fix.
+    let out = varspec(&["spectrum", "--integrand", "defocus:c=0.5"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--dims"));
+    let out = varspec(&["spectrum", "--integrand", "disk:r=0.3", "--dims", "0,2"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("two distinct coordinates of 0..2"));
+    let out = varspec(&["spectrum"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--integrand"));
+}

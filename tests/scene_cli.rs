@@ -158,3 +158,50 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_pixels_light_field_power_lies_on_its_sheared_line() {
+    // Pixel (33, 1) of `dof` sees the back wall, κ = −5.28 pixels per lens
+    // unit (results/scene §3): f(x, u) = g(x + κu), whose XU power lies on
+    // k_u = κ·k_x. At k_x = 1 the line passes k_u = −5, the mirror k_u = +5
+    // is off it (the wrong sign of the shear).
+    let dir = temp_dir("pixel-power");
+    let csv = dir.join("xu.csv");
+    let out = varspec_with(
+        &[
+            "spectrum",
+            "--integrand",
+            "scene:dof,px=33,py=1",
+            "--dims",
+            "0,2",
+            "--res",
+            "17",
+            "--csv",
+            csv.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let at = |k: &str| -> f64 {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&format!("{k},")))
+            .unwrap_or_else(|| panic!("no row {k}"));
+        line.rsplit(',').next().unwrap().parse().unwrap()
+    };
+    let (on, off) = (at("1,-5"), at("1,5"));
+    assert!(
+        on > 100.0 * off,
+        "power on the line {on:e}, at its mirror {off:e}"
+    );
+    assert_fails(
+        &["spectrum", "--integrand", "scene:dof,px=33,py=1"],
+        "--dims",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

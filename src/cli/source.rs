@@ -15,7 +15,7 @@ use varspec::source::Source;
 #[derive(clap::Args)]
 pub struct SourceArgs {
     /// Point-set file (CSV or UTK text); every set in it is used.
-    #[arg(conflicts_with_all = ["sampler", "points_flag"], required_unless_present_any = ["sampler", "points_flag"])]
+    #[arg(conflicts_with_all = ["sampler", "points_flag"])]
     points: Option<PathBuf>,
     /// The same as the positional point-set file.
     #[arg(long = "points", conflicts_with = "sampler", value_name = "FILE")]
@@ -45,6 +45,20 @@ impl SourceArgs {
     /// The seed given with --seed.
     pub fn seed(&self) -> u64 {
         self.draw.seed
+    }
+
+    /// True when a point-set file or a sampler was given.
+    pub fn given(&self) -> bool {
+        self.points.is_some() || self.points_flag.is_some() || self.sampler.is_some()
+    }
+
+    /// The plane given with --dims, checked to be two distinct indices
+    /// (what the spectrum of a 4D integrand is drawn on).
+    pub fn plane(&self) -> anyhow::Result<Option<[usize; 2]>> {
+        self.dims
+            .as_deref()
+            .map(|d| args::dims(d, 2).map(|v| [v[0], v[1]]))
+            .transpose()
     }
 
     /// Reads the file or builds the sampler; checks that the (projected)
@@ -101,7 +115,11 @@ impl SourceArgs {
                     name: format!("{name} N={n}"),
                 }
             }
-            (None, None) => bail!("give a point-set file or --sampler"),
+            (None, None) => {
+                bail!(
+                    "no points given: name a point-set file (or --points FILE), or draw them with --sampler NAME -n N"
+                )
+            }
         };
         // Check the projection against the points' dimension without drawing
         // a realization (an optimized sampler's draw is a whole descent).

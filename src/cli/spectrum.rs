@@ -2,17 +2,19 @@
 
 use std::path::PathBuf;
 
-use anyhow::bail;
+use anyhow::{Context, bail};
 use clap::ValueEnum;
 
 use super::progress;
 use super::source::SourceArgs;
+use varspec::integrands::Integrand;
 use varspec::io::npy::write_npy;
 use varspec::io::write_atomic;
-use varspec::report::plot::{LinePlot, Series, line_plot_png, spectrum_png};
+use varspec::report::plot::{LinePlot, Series, line_plot_png, power_png};
+use varspec::scene::pixel::PixelIntegrand;
 use varspec::spectrum::expected::check_memory;
 use varspec::spectrum::radial::radial_profile;
-use varspec::spectrum::{FrequencyBox, Method, expected_power};
+use varspec::spectrum::{FrequencyBox, Method, Spectrum, expected_power};
 
 #[derive(Clone, Copy, ValueEnum)]
 enum MethodArg {
@@ -26,15 +28,22 @@ enum MethodArg {
 pub struct Args {
     #[command(flatten)]
     source: SourceArgs,
+    /// Instead of points: the power spectrum P_f = |F_f(k)|² of this
+    /// integrand (e.g. disk:r=0.3), a 4D one on the plane --dims (0,2 is
+    /// XU, 1,3 is YV). A scene pixel (scene:NAME,px=X,py=Y) has no closed
+    /// form: its marginal on the plane is averaged over a 4K × 4K grid of
+    /// cells, 16 random rays each (seeded by --seed), then transformed.
+    #[arg(long, conflicts_with_all = ["points", "points_flag", "sampler", "n", "sets_given", "params", "density", "method", "tol"])]
+    integrand: Option<String>,
     /// Resolution K: the frequency box |k| < K/2 in each axis.
     #[arg(long, default_value_t = 128)]
     res: usize,
-    /// How S(k) is computed.
-    #[arg(long, value_enum, default_value_t = MethodArg::Fast)]
-    method: MethodArg,
-    /// Relative tolerance of the fast method (1e-14 to 0.1).
-    #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
-    tol: f64,
+    /// How S(k) is computed (default fast).
+    #[arg(long, value_enum)]
+    method: Option<MethodArg>,
+    /// Relative tolerance of the fast method (1e-14 to 0.1; default 1e-9).
+    #[arg(long, allow_hyphen_values = true)]
+    tol: Option<f64>,
     /// CSV of the spectrum: kx,ky,power.
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -53,6 +62,45 @@ pub struct Args {
     radial_png: Option<PathBuf>,
 }
 
+/// Frequency axis names of the coordinates x, y, u, v.
+const AXES: [&str; 4] = ["kx", "ky", "ku", "kv"];
+
+/// P_f of the integrand `spec` on `plane` (a 2D integrand's own plane by
+/// default) on |k|∞ ≤ `half`, and its name.
+fn integrand_power(
+    spec: &str,
+    plane: Option<[usize; 2]>,
+    half: usize,
+    seed: u64,
+) -> anyhow::Result<(Spectrum, String)> {
+    if PixelIntegrand::is_pixel_spec(spec) {
+        let f = PixelIntegrand::parse(spec)?;
+        let dims = plane.context(
+            "a pixel is a 4D integrand: choose the plane of its spectrum with --dims (0,2 is XU, 1,3 is YV)",
+        )?;
+        let grid = half
+            .checked_mul(4)
+            .filter(|&g| g >= 8)
+            .context("--res must be at least 5 for a pixel (and at most 2^60)")?;
+        let power = f.plane_power(dims, grid, PIXEL_RAYS_PER_CELL, seed)?;
+        return Ok((power, f.spec()));
+    }
+    let f = varspec::integrands::parse(spec)?;
+    let dims = match (plane, f.dim()) {
+        (Some(dims), _) => dims,
+        (None, 2) => [0, 1],
+        (None, d) => bail!(
+            "{} is {d}-dimensional: choose the plane of its spectrum with --dims (0,2 is XU, 1,3 is YV)",
+            f.spec()
+        ),
+    };
+    Ok((varspec::integrands::plane_power(&*f, dims, half)?, f.spec()))
+}
+
+/// Random rays averaged per cell of a pixel's marginal (the scene
+/// module's default for its light-field pictures).
+const PIXEL_RAYS_PER_CELL: usize = 16;
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     if a.res < 2 {
         bail!("--res {}: the box |k| < K/2 needs K >= 2", a.res);
@@ -64,22 +112,45 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.png.as_deref(),
         a.radial_png.as_deref(),
     ])?;
-    let method = match a.method {
-        MethodArg::Fast => Method::Fast { tolerance: a.tol },
-        MethodArg::Direct => Method::Direct,
-    };
     let freqs = FrequencyBox::from_resolution(2, a.res);
-    check_memory(&freqs, method, a.res)?;
-    let source = a.source.resolve(Some(2))?;
-    let bar = progress::bar(source.count() as u64, "spectrum");
-    let spectrum = expected_power(
-        freqs,
-        method,
-        source.count(),
-        |r| source.get(r).map_err(anyhow::Error::from),
-        &|| bar.inc(1),
-    )?;
-    bar.finish_and_clear();
+    let plane = a.source.plane()?;
+    let axes = match plane {
+        Some(dims) => dims.map(|d| AXES.get(d).copied().unwrap_or("k")),
+        None => ["kx", "ky"],
+    };
+    let (spectrum, title, bar_label) = match &a.integrand {
+        Some(spec) => {
+            let (power, name) = integrand_power(spec, plane, freqs.half, a.source.seed())?;
+            (power, format!("{name}, P_f"), "log10 |F_f(k)|^2")
+        }
+        None => {
+            if !a.source.given() {
+                bail!(
+                    "nothing to analyse: name a point-set file (or --points FILE), draw sets with \
+                     --sampler NAME -n N, or give --integrand SPEC for an integrand's power"
+                );
+            }
+            let method = match a.method.unwrap_or(MethodArg::Fast) {
+                MethodArg::Fast => Method::Fast {
+                    tolerance: a.tol.unwrap_or(1e-9),
+                },
+                MethodArg::Direct => Method::Direct,
+            };
+            check_memory(&freqs, method, a.res)?;
+            let source = a.source.resolve(Some(2))?;
+            let bar = progress::bar(source.count() as u64, "spectrum");
+            let spectrum = expected_power(
+                freqs,
+                method,
+                source.count(),
+                |r| source.get(r).map_err(anyhow::Error::from),
+                &|| bar.inc(1),
+            )?;
+            bar.finish_and_clear();
+            let title = format!("{} ({} sets)", source.name(), spectrum.sets);
+            (spectrum, title, "log10 power (N·P_S)")
+        }
+    };
     let profile = radial_profile(&spectrum);
     let radial_csv = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
         writeln!(w, "k,power,anisotropy")?;
@@ -106,28 +177,36 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(path) = &a.radial {
         write_atomic(path, radial_csv)?;
     }
-    let title = format!("{} ({} sets)", source.name(), spectrum.sets);
     if let Some(path) = &a.png {
-        spectrum_png(&spectrum, &title, path)?;
+        power_png(&spectrum, &title, axes, bar_label, path)?;
     }
     if let Some(path) = &a.radial_png {
         let plot = LinePlot {
             title: format!("radial power: {title}"),
             x_label: "|k|".into(),
-            y_label: "power (N·P_S)".into(),
-            log_log: false,
-            series: vec![
-                Series {
-                    label: "radial mean".into(),
-                    points: profile.iter().map(|b| (b.k as f64, b.power)).collect(),
-                    reference: false,
-                },
-                Series {
-                    label: "white noise".into(),
-                    points: vec![(1.0, 1.0), (freqs.half as f64, 1.0)],
-                    reference: true,
-                },
-            ],
+            y_label: if a.integrand.is_some() {
+                "power P_f".into()
+            } else {
+                "power (N·P_S)".into()
+            },
+            // An integrand's power decays over decades; a set's is read
+            // against white noise.
+            log_log: a.integrand.is_some(),
+            series: std::iter::once(Series {
+                label: "radial mean".into(),
+                points: profile
+                    .iter()
+                    .filter(|b| a.integrand.is_none() || b.k > 0)
+                    .map(|b| (b.k as f64, b.power))
+                    .collect(),
+                reference: false,
+            })
+            .chain(a.integrand.is_none().then(|| Series {
+                label: "white noise".into(),
+                points: vec![(1.0, 1.0), (freqs.half as f64, 1.0)],
+                reference: true,
+            }))
+            .collect(),
         };
         line_plot_png(&plot, path)?;
     }

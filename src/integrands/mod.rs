@@ -14,6 +14,7 @@ mod gaussian;
 mod halfplane;
 mod layers;
 mod light_field;
+mod plane_power;
 mod rect;
 mod spec;
 
@@ -24,6 +25,7 @@ pub use gaussian::Gaussian;
 pub use halfplane::HalfPlane;
 pub use layers::Layers;
 pub use light_field::{LightField, PlaneWave, energy as light_field_energy};
+pub use plane_power::{check_plane, plane_power};
 pub use rect::Rect;
 pub use spec::{INTEGRANDS, IntegrandInfo, parse};
 

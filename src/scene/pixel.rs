@@ -14,7 +14,7 @@ use rustfft::num_complex::Complex64;
 
 use super::Scene;
 use super::description::SceneError;
-use crate::integrands::{Integrand, IntegrandClass};
+use crate::integrands::{Integrand, IntegrandClass, check_plane};
 use crate::points::PointSet;
 use crate::rng::{set_rng, uniform};
 use crate::spectrum::{FrequencyBox, NufftPlan, Sign, Spectrum, SpectrumError};
@@ -185,16 +185,18 @@ impl PixelIntegrand {
         seed: u64,
     ) -> Result<Spectrum, SpectrumError> {
         use rayon::prelude::*;
-        if dims[0] == dims[1] || dims.iter().any(|&d| d >= 4) {
-            return Err(SpectrumError::Plane(format!(
-                "two distinct coordinates of 0..4, not {dims:?}"
-            )));
-        }
+        check_plane(dims, 4)?;
         if grid < 8 || per_cell == 0 {
             return Err(SpectrumError::Plane(format!(
                 "a grid of at least 8 cells per axis and a sample per cell, not {grid} and {per_cell}"
             )));
         }
+        // Cell averages, their centres and strengths: 40 bytes a cell.
+        crate::memory::check(
+            &format!("the pixel's {grid}² cell averages"),
+            grid.checked_mul(grid).map(|n| n as f64 * 40.0),
+            "lower the resolution",
+        )?;
         let cells: Vec<f64> = (0..grid * grid)
             .into_par_iter()
             .map(|c| {

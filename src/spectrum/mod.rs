@@ -53,7 +53,8 @@ pub enum SpectrumError {
     /// A bad pair-correlation parameter.
     #[error("pair correlation: {0}")]
     Pcf(String),
-    /// A bad plane or grid for a light field's plane spectrum.
-    #[error("light-field plane spectrum: {0}")]
+    /// A bad plane or grid for an integrand's (a light field's) spectrum
+    /// on a plane of its coordinates.
+    #[error("spectrum on a plane: {0}")]
     Plane(String),
 }
