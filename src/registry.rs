@@ -288,11 +288,24 @@ pub type Params = Vec<(String, String)>;
 /// the shorthand's so they win.
 ///
 /// # Errors
-/// [`SamplerError::Syntax`] for a part that is not key=value.
+/// [`SamplerError::Syntax`] for a part that is not key=value,
+/// [`SamplerError::RepeatedParam`] for a key given twice in one place.
 pub fn split_spec<'a>(
     name: &'a str,
     params: &[(String, String)],
 ) -> Result<(&'a str, Params), SamplerError> {
+    let repeated = |list: &[(String, String)]| {
+        list.iter()
+            .enumerate()
+            .find(|(i, (k, _))| list[..*i].iter().any(|(j, _)| j == k))
+            .map(|(_, (k, _))| SamplerError::RepeatedParam {
+                spec: name.to_string(),
+                key: k.clone(),
+            })
+    };
+    if let Some(e) = repeated(params) {
+        return Err(e);
+    }
     let Some((name, rest)) = name.split_once(':') else {
         return Ok((name, params.to_vec()));
     };
@@ -303,6 +316,9 @@ pub fn split_spec<'a>(
             part: part.to_string(),
         })?;
         all.push((k.trim().to_string(), v.trim().to_string()));
+    }
+    if let Some(e) = repeated(&all) {
+        return Err(e);
     }
     all.extend_from_slice(params);
     Ok((name, all))

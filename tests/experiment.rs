@@ -70,6 +70,32 @@ fn shards_merged_equal_the_single_run_byte_for_byte() {
         "shard 1/3 is missing",
     );
     assert_fails(&["experiment", f, "--shard", "3/3"], "0 <= i < n");
+    // Runs of the other kind into one folder: a whole run removes the
+    // shards, a shard run the tables and shards of another split; a user's
+    // own file stays.
+    let mixed = dir.join("mixed");
+    let m = mixed.to_str().unwrap();
+    ok(&["experiment", f, "--shard", "0/2", "-o", m]);
+    ok(&["experiment", f, "--shard", "1/3", "-o", m]);
+    assert!(
+        !mixed.join("shard-0-of-2.json").exists(),
+        "another split's shard stayed"
+    );
+    std::fs::write(mixed.join("notes.txt"), "mine").unwrap();
+    ok(&["experiment", f, "-o", m]);
+    assert!(
+        !mixed.join("shard-1-of-3.json").exists(),
+        "a shard stayed beside the tables"
+    );
+    ok(&["experiment", f, "--shard", "0/2", "-o", m]);
+    for stale in ["README.md", "variances.csv", "slopes.csv"] {
+        assert!(!mixed.join(stale).exists(), "{stale} stayed beside a shard");
+    }
+    assert!(mixed.join("notes.txt").exists());
+    // A failed run names its file.
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, SMALL.replace("\"disk:r=0.3\"", "\"nosuch\"")).unwrap();
+    assert_fails(&["experiment", bad.to_str().unwrap()], "bad.json");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -33,17 +33,23 @@ pub fn dims(text: &str, count: usize) -> anyhow::Result<Vec<usize>> {
 #[derive(clap::Args)]
 pub struct DrawArgs {
     /// Realizations to draw (with a sampler; default 16).
-    #[arg(long = "sets")]
+    #[arg(value_parser = whole::<usize>, allow_negative_numbers = true, long = "sets", value_name = "SETS")]
     sets_given: Option<usize>,
-    /// Seed: the same seed gives bit-identical realizations for any thread count.
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// Seed (default 0): the same seed gives bit-identical realizations
+    /// for any thread count.
+    #[arg(value_parser = whole::<u64>, allow_negative_numbers = true, long = "seed")]
+    seed_given: Option<u64>,
     /// Sampler parameter key=value (repeatable; see `varspec sample --list`).
     #[arg(long = "param", value_parser = key_value)]
     pub params: Vec<(String, String)>,
 }
 
 impl DrawArgs {
+    /// The seed: --seed, default 0.
+    pub fn seed(&self) -> u64 {
+        self.seed_given.unwrap_or(0)
+    }
+
     /// Realizations to draw: --sets, default 16.
     pub fn sets(&self) -> usize {
         self.sets_given.unwrap_or(16)
@@ -63,10 +69,18 @@ impl DrawArgs {
 
     /// Refuses --sets and --param where sets come from a file (they would
     /// be silently ignored).
-    pub fn refuse_with_file(&self, file: &std::path::Path) -> anyhow::Result<()> {
+    /// `seed_used`: the command draws something else from --seed with a
+    /// file (a family's members), so --seed is not refused.
+    pub fn refuse_with_file(&self, file: &std::path::Path, seed_used: bool) -> anyhow::Result<()> {
         if self.sets_given.is_some() || !self.params.is_empty() {
             anyhow::bail!(
                 "--sets and --param apply to --sampler; {} is read whole, every set in it is used",
+                file.display()
+            );
+        }
+        if self.seed_given.is_some() && !seed_used {
+            anyhow::bail!(
+                "--seed applies to --sampler; {} holds fixed sets, so a seed would change nothing",
                 file.display()
             );
         }
@@ -83,6 +97,36 @@ pub fn check_outputs<'a>(
         varspec::io::check_output(path)?;
     }
     Ok(())
+}
+
+/// A whole number ≥ 0 for counts, sizes and seeds, written plainly (16)
+/// or in scientific notation when that is whole (1e3); negative,
+/// fractional and too large values are refused naming what was typed
+/// (clap's own parser says "invalid digit found in string").
+pub fn whole<T: TryFrom<u64>>(text: &str) -> Result<T, String> {
+    let value = match text.parse::<u64>() {
+        Ok(v) => v,
+        Err(_) => match text.parse::<f64>() {
+            Ok(v) if v < 0.0 => {
+                return Err(format!(
+                    "`{text}` is negative; expected a whole number >= 0"
+                ));
+            }
+            Ok(v) if !v.is_finite() || v.fract() != 0.0 => {
+                return Err(format!("`{text}` is not a whole number"));
+            }
+            // 2^64 is exactly representable; below it the cast is exact
+            // for every whole f64.
+            Ok(v) if v < 18_446_744_073_709_551_616.0 => v as u64,
+            Ok(_) => return Err(format!("`{text}` is larger than 2^64 - 1")),
+            Err(_) => {
+                return Err(format!(
+                    "`{text}` is not a whole number (write e.g. 16 or 1e3)"
+                ));
+            }
+        },
+    };
+    T::try_from(value).map_err(|_| format!("`{text}` is too large for this option"))
 }
 
 /// A point count N: a whole number ≥ 1, written plainly (1024) or in

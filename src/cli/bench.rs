@@ -34,7 +34,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "out/bench/bench-render.csv")]
     csv: PathBuf,
     /// Sphere tessellation of the five spheres (5: 102,400 triangles).
-    #[arg(long, default_value_t = 5)]
+    #[arg(value_parser = super::args::whole::<u32>, allow_negative_numbers = true, long, default_value_t = 5)]
     subdivisions: u32,
 }
 

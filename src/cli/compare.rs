@@ -33,10 +33,10 @@ pub struct Args {
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true, default_value_t = 1024)]
     n: usize,
     /// Realizations per sampler.
-    #[arg(long, default_value_t = 16)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 16)]
     sets: usize,
     /// Seed.
-    #[arg(long, default_value_t = 0)]
+    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Folder for the summary CSV and one PNG per sampler.
     #[arg(short = 'o', long = "output", default_value = "out/compare")]

@@ -40,10 +40,10 @@ pub struct Args {
     #[arg(long)]
     family: Option<String>,
     /// Members of the family sample (with --family).
-    #[arg(long, default_value_t = 1024)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
     members: usize,
     /// Comma-separated N values (constrained samplers use the nearest valid N).
-    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true, value_delimiter = ',', required = true)]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_hyphen_values = true, value_delimiter = ',', required = true)]
     ns: Vec<usize>,
     #[command(flatten)]
     draw: DrawArgs,
@@ -51,7 +51,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
     /// Fourier box |k| < K/2 for --method fourier (default 256 in 2D, 21 in 4D).
-    #[arg(long)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// CSV of N against variance.
     #[arg(long)]
@@ -68,7 +68,8 @@ struct Point {
     requested: usize,
     n: usize,
     variance: f64,
-    stderr: f64,
+    /// `None` from a single set: unknown, not 0.
+    stderr: Option<f64>,
     truncation_bound: f64,
 }
 
@@ -118,13 +119,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let (sampler, n) =
             registry::build_nearest(&a.sampler, requested, Some(dim), &a.draw.params)?;
         let realization = |r: usize| -> Result<_, VarianceError> {
-            Ok(sampler.sample(&mut set_rng(a.draw.seed, r as u64))?)
+            Ok(sampler.sample(&mut set_rng(a.draw.seed(), r as u64))?)
         };
         let (variance, stderr, truncation_bound) = match (&subject, method) {
             (Subject::Square(family), _) => {
-                let sets =
-                    samplers::generate_sets(sampler.as_ref(), a.draw.seed, a.draw.sets(), &|| {})?;
-                let e = family_mse(&sets, family, a.members, a.draw.seed);
+                let sets = samplers::generate_sets(
+                    sampler.as_ref(),
+                    a.draw.seed(),
+                    a.draw.sets(),
+                    &|| {},
+                )?;
+                let e = family_mse(&sets, family, a.members, a.draw.seed());
                 (e.mse, e.stderr, 0.0)
             }
             (Subject::Torus(f), MethodArg::Spatial) => {
@@ -160,7 +165,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             requested,
             n,
             variance,
-            stderr,
+            stderr: (a.draw.sets() >= 2).then_some(stderr),
             truncation_bound,
         });
         bar.inc(1);
@@ -182,10 +187,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         write_atomic(path, |w| {
             writeln!(w, "n,variance,stderr,truncation_bound")?;
             for p in &points {
+                let stderr = p.stderr.map_or(String::new(), |s| format!("{s:?}"));
                 writeln!(
                     w,
-                    "{},{:?},{:?},{:?}",
-                    p.n, p.variance, p.stderr, p.truncation_bound
+                    "{},{:?},{stderr},{:?}",
+                    p.n, p.variance, p.truncation_bound
                 )?;
             }
             Ok(())
@@ -241,7 +247,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     println!("{:>8} {:>14} {:>12}", "N", "variance", "stderr");
     for p in &points {
-        println!("{:>8} {:>14.6e} {:>12.2e}", p.n, p.variance, p.stderr);
+        let stderr = p.stderr.map_or("unknown".into(), |s| format!("{s:.2e}"));
+        println!("{:>8} {:>14.6e} {stderr:>12}", p.n, p.variance);
     }
     let ci = fit
         .slope_ci

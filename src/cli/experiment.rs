@@ -48,7 +48,8 @@ pub struct MergeArgs {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     let file = a.file.display().to_string();
-    let text = std::fs::read_to_string(&a.file).with_context(|| format!("cannot read {file}"))?;
+    let text = varspec::io::read_text_bounded(&a.file, 16 << 20, "an experiment file")
+        .with_context(|| format!("cannot read {file}"))?;
     let e = Experiment::parse(&text, &file)?;
     let out = a
         .output
@@ -62,6 +63,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // The folder is made only once there is something to write.
     std::fs::create_dir_all(&out)
         .with_context(|| format!("{file}: cannot create {}", out.display()))?;
+    varspec::experiment::remove_other_runs(&out, a.shard)?;
     if a.shard.is_some() {
         let name = format!("shard-{}-of-{}.json", shard.index, shard.count);
         let shard_file = ShardFile {
@@ -101,8 +103,8 @@ pub fn merge(a: MergeArgs) -> anyhow::Result<()> {
         );
     }
     for p in &paths {
-        let text =
-            std::fs::read_to_string(p).with_context(|| format!("cannot read {}", p.display()))?;
+        let text = varspec::io::read_text_bounded(p, 1 << 30, "an experiment shard")
+            .with_context(|| format!("cannot read {}", p.display()))?;
         let shard: ShardFile = serde_json::from_str(&text)
             .with_context(|| format!("{}: not a shard file", p.display()))?;
         shards.push(shard);

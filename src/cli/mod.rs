@@ -83,7 +83,8 @@ enum Command {
 /// Parses the arguments, runs the subcommand, reports any error on stderr.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
+    // A command's outputs appear together or not at all.
+    let result = varspec::io::all_or_nothing(|| match cli.command {
         Command::Report(a) => report::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Plot(c) => plot::run(c),
@@ -109,7 +110,7 @@ pub fn main() -> ExitCode {
         Command::Render(a) => render::run(a),
         Command::Tables(a) => tables::run(a),
         Command::Integrands(a) => integrands::run(a),
-    };
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,

@@ -46,17 +46,17 @@ pub struct ShearArgs {
     integrand: String,
     /// Sheared sets written with -o (the search itself uses the expected
     /// variance over the sampler's randomness, not these sets).
-    #[arg(long, default_value_t = 16)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 16)]
     sets: usize,
     /// Seed of the written sets, of the independent check and of any
     /// realizations behind an estimated half.
-    #[arg(long, default_value_t = 0)]
+    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Shears searched in [−range, range] on each axis.
     #[arg(long, default_value_t = 2.0)]
     range: f64,
     /// Fresh realizations of the independent before/after check (0: skip it).
-    #[arg(long, default_value_t = 4000)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 4000)]
     realizations: usize,
     /// Write the sheared sets here (CSV).
     #[arg(short = 'o', long = "output")]
@@ -75,7 +75,7 @@ pub struct PointsArgs {
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: usize,
     /// Dimension (1 to 4).
-    #[arg(short = 'd', long = "dim", default_value_t = 2)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'd', long = "dim", default_value_t = 2)]
     dim: usize,
     /// Where the points are used: on the torus under a random shift, or
     /// on the unit square as they are (no shift).
@@ -87,13 +87,13 @@ pub struct PointsArgs {
     #[arg(long)]
     target: String,
     /// Independent realizations, optimized in parallel.
-    #[arg(long, default_value_t = 1)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1)]
     sets: usize,
     /// Maximum iterations per set (default 1000 on the torus, 2000 on the square).
-    #[arg(long)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     iters: Option<usize>,
     /// Seed of the starting sets.
-    #[arg(long, default_value_t = 0)]
+    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Sampler of the starting sets (default: lattice, the best integration
     /// lattice by the exact variance, for 2D integrands with a closed-form
@@ -102,16 +102,16 @@ pub struct PointsArgs {
     #[arg(long)]
     init: Option<String>,
     /// Square: family members the result and the classic samplers are scored on.
-    #[arg(long, default_value_t = 1024)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
     members: usize,
     /// Square: seed of the scoring members (the descent draws its own members
     /// from --seed on other streams).
-    #[arg(long, default_value_t = 1)]
+    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 1)]
     score_seed: u64,
     /// Frequency box |k| < K/2 of the loss, as in spectrum and predict
     /// (default K = 2h + 1 with h = 2.5·N^(1/d) within [16, 400] for families
     /// and power laws, 8·N^(1/d) within [32, 256] for integrands).
-    #[arg(long)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// NUFFT tolerance of the loss and gradient (the speed/accuracy knob;
     /// default 1e-6, as the blue-noise sampler).
@@ -931,7 +931,24 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     };
     use varspec::samplers::Sampler;
     use varspec::variance::{VarianceError, empirical_shifting};
-    args::check_outputs([a.output.as_deref()])?;
+    // The pictures --png-prefix names (a pixel also gets its light field's).
+    let pictures: Vec<std::path::PathBuf> = a
+        .png_prefix
+        .iter()
+        .flat_map(|prefix| {
+            PLANES.iter().flat_map(move |(name, _, _)| {
+                [
+                    format!("{prefix}-{name}-before.png"),
+                    format!("{prefix}-{name}-after.png"),
+                    format!("{prefix}-f-{name}.png"),
+                ]
+                .map(std::path::PathBuf::from)
+            })
+        })
+        .collect();
+    args::check_outputs(
+        std::iter::once(a.output.as_deref()).chain(pictures.iter().map(|p| Some(p.as_path()))),
+    )?;
     if varspec::scene::pixel::PixelIntegrand::is_pixel_spec(&a.integrand) {
         return shear_pixel(a);
     }

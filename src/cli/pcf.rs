@@ -19,7 +19,7 @@ pub struct Args {
     #[arg(long, default_value_t = 2.5)]
     range: f64,
     /// Radii evaluated in (0, range].
-    #[arg(long, default_value_t = 100)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 100)]
     bins: usize,
     /// Gaussian kernel standard deviation σ, in units of r_max.
     #[arg(long, default_value_t = 0.15)]
@@ -34,6 +34,15 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
+    if !(a.range.is_finite() && a.range > 0.0) {
+        bail!(
+            "--range {:?}: the largest radius, in units of the packing distance r_max, must be a positive number (default 2.5)",
+            a.range
+        );
+    }
+    if a.bins == 0 {
+        bail!("--bins 0: the number of radii must be at least 1 (default 100)");
+    }
     if !(a.bandwidth.is_finite() && a.bandwidth >= 1e-3 && a.bandwidth <= a.range) {
         bail!(
             "--bandwidth {:?}: the kernel's σ, in units of the packing distance r_max, must be in \
@@ -57,6 +66,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         packing_radius(n, d.min(4))
     };
+    // The estimator needs (range + 6σ)·r_max < 1/2 (beyond, toroidal
+    // distances alias): say so in the units the options are given in.
+    let reach = a.range + 6.0 * a.bandwidth;
+    if reach * unit >= 0.5 {
+        let largest = 0.5 / unit - 6.0 * a.bandwidth;
+        bail!(
+            "--range {:?} + 6 x --bandwidth {:?} = {reach:.3} packing distances reaches half the torus \
+             (r_max = {unit:.4} for N = {n}: the pair correlation aliases beyond {:.3} r_max); {}",
+            a.range,
+            a.bandwidth,
+            0.5 / unit,
+            if largest > a.bandwidth {
+                format!("lower --range to below {largest:.3}, or use more points")
+            } else {
+                "use more points (or a smaller --bandwidth)".to_string()
+            }
+        );
+    }
     let pcf = pair_correlation(&sets, a.range * unit, a.bins, a.bandwidth * unit)?;
     let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
         writeln!(w, "r,r_rel,g")?;

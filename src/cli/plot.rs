@@ -23,10 +23,10 @@ pub struct PointsArgs {
     #[arg(long, default_value = "0,1")]
     dims: String,
     /// Which set of the file to draw (from 0).
-    #[arg(long, default_value_t = 0)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 0)]
     set: usize,
     /// Image side in pixels.
-    #[arg(long, default_value_t = 512)]
+    #[arg(value_parser = super::args::whole::<u32>, allow_negative_numbers = true, long, default_value_t = 512)]
     size: u32,
     /// Output PNG.
     #[arg(short = 'o', long = "output")]

@@ -39,16 +39,16 @@ pub struct Args {
     #[arg(long)]
     family: Option<String>,
     /// Members of the family sample (with --family).
-    #[arg(long, default_value_t = 1024)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
     members: usize,
     /// Which predictor(s) to run.
     #[arg(long, value_enum, default_value_t = MethodArg::All)]
     method: MethodArg,
     /// Realizations (fresh sampler randomness and shift each) of the empirical predictor.
-    #[arg(long, default_value_t = 10_000)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 10_000)]
     realizations: usize,
     /// Fourier box |k| < K/2 (default 256 in 2D, 16 in 4D).
-    #[arg(long)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// NUFFT tolerance of the Fourier predictor's spectrum.
     #[arg(long, default_value_t = 1e-10)]
@@ -223,7 +223,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 }
                 _ => match v[extra].as_f64() {
                     Some(x) => format!("{extra} {x:.2e}"),
-                    None => format!("{extra} unknown (one set: give --sets 2 or more)"),
+                    None => format!(
+                        "{extra} unknown (one set: draw 2 or more with --sets, or give a file of 2 or more sets)"
+                    ),
                 },
             };
             println!("  {key:<10} {variance:>14}  {note}");
@@ -240,7 +242,7 @@ fn square(a: &Args) -> anyhow::Result<()> {
     use varspec::square::{Family, family_mse};
 
     let family = Family::parse(a.family.as_deref().unwrap_or_default())?;
-    let source = a.source.resolve(Some(2))?;
+    let source = a.source.resolve_seeded(Some(2))?;
     varspec::square::mse::check_family_memory(a.members, source.count())?;
     let sets = source.realizations()?;
     let n = source.points_per_set();

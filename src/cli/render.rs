@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long, default_value = "umj")]
     sampler: String,
     /// Samples per pixel (the sampler's N; umj needs a square).
-    #[arg(long, default_value_t = 16)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 16)]
     spp: usize,
     /// Shear of each pixel's set: none; analytic (the shear following the
     /// centre depth's light field); pilot (the best of none and every
@@ -36,13 +36,13 @@ pub struct Args {
     #[arg(long, default_value = "none", allow_hyphen_values = true)]
     shear: String,
     /// Pilot estimates per candidate shear (--shear pilot).
-    #[arg(long, default_value_t = 8)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 8)]
     pilots: usize,
     /// Seed: the same seed gives the same image for any thread count.
-    #[arg(long, default_value_t = 0)]
+    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Independent renders; 2 or more also give the per-pixel variance.
-    #[arg(long, default_value_t = 1)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1)]
     renders: usize,
     /// Tone-mapped PNG of the (mean) image (default out/render/SCENE.png).
     #[arg(short = 'o', long = "output")]

@@ -15,10 +15,10 @@ pub struct Args {
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true, default_value_t = 256)]
     n: usize,
     /// Sets per sampler.
-    #[arg(long, default_value_t = 16)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 16)]
     sets: usize,
     /// Seed of everything.
-    #[arg(long, default_value_t = 0)]
+    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Integrand of the sampler comparison.
     #[arg(long, default_value = "disk:r=0.3")]

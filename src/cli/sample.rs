@@ -56,13 +56,13 @@ pub struct Args {
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true, required_unless_present = "list")]
     n: Option<usize>,
     /// Dimension (default: the sampler's own, 2 for most, 4 for umj).
-    #[arg(short = 'd', long = "dim")]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'd', long = "dim")]
     dim: Option<usize>,
     /// Seed: the same seed gives bit-identical output for any thread count.
-    #[arg(long, default_value_t = 0)]
+    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Number of independent realizations.
-    #[arg(long, default_value_t = 1)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1)]
     sets: usize,
     /// Sampler parameter key=value (repeatable; see --list).
     #[arg(long = "param", value_parser = args::key_value)]

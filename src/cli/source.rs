@@ -27,7 +27,7 @@ pub struct SourceArgs {
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: Option<usize>,
     /// Sampler dimension (with --sampler; default: the sampler's own).
-    #[arg(short = 'd', long = "dim")]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'd', long = "dim")]
     dim: Option<usize>,
     #[command(flatten)]
     draw: args::DrawArgs,
@@ -44,7 +44,7 @@ pub struct SourceArgs {
 impl SourceArgs {
     /// The seed given with --seed.
     pub fn seed(&self) -> u64 {
-        self.draw.seed
+        self.draw.seed()
     }
 
     /// True when a point-set file or a sampler was given.
@@ -64,6 +64,16 @@ impl SourceArgs {
     /// Reads the file or builds the sampler; checks that the (projected)
     /// points are `dim`-dimensional (any dimension for `None`).
     pub fn resolve(&self, dim: Option<usize>) -> anyhow::Result<Source> {
+        self.resolve_with(dim, false)
+    }
+
+    /// As [`SourceArgs::resolve`] for a command that also draws from --seed
+    /// with a file (a family's members): --seed is then not refused.
+    pub fn resolve_seeded(&self, dim: Option<usize>) -> anyhow::Result<Source> {
+        self.resolve_with(dim, true)
+    }
+
+    fn resolve_with(&self, dim: Option<usize>, seed_used: bool) -> anyhow::Result<Source> {
         let dims = self
             .dims
             .as_deref()
@@ -74,7 +84,7 @@ impl SourceArgs {
             &self.sampler,
         ) {
             (Some(path), _) => {
-                self.draw.refuse_with_file(path)?;
+                self.draw.refuse_with_file(path, seed_used)?;
                 if self.n.is_some() || self.dim.is_some() {
                     bail!(
                         "-n and --dim apply to --sampler; {} fixes N and d itself",
@@ -109,7 +119,7 @@ impl SourceArgs {
                 let sampler = registry::build(name, n, self.dim, &self.draw.params)?;
                 Source::Sampler {
                     sampler,
-                    seed: self.draw.seed,
+                    seed: self.draw.seed(),
                     sets: self.draw.sets(),
                     dims: dims.clone(),
                     name: format!("{name} N={n}"),

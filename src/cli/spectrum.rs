@@ -36,7 +36,7 @@ pub struct Args {
     #[arg(long, conflicts_with_all = ["points", "points_flag", "sampler", "n", "sets_given", "params", "density", "method", "tol"])]
     integrand: Option<String>,
     /// Resolution K: the frequency box |k| < K/2 in each axis.
-    #[arg(long, default_value_t = 128)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 128)]
     res: usize,
     /// How S(k) is computed (default fast).
     #[arg(long, value_enum)]

@@ -37,7 +37,7 @@ pub struct Args {
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: Option<usize>,
     /// Dimension (with --sampler).
-    #[arg(short = 'd', long = "dim")]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'd', long = "dim")]
     dim: Option<usize>,
     #[command(flatten)]
     draw: DrawArgs,
@@ -65,12 +65,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             let s = registry::build(name, n, a.dim, &a.draw.params)?;
             let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =
-                samplers::generate_sets(s.as_ref(), a.draw.seed, a.draw.sets(), &|| bar.inc(1))?;
+                samplers::generate_sets(s.as_ref(), a.draw.seed(), a.draw.sets(), &|| bar.inc(1))?;
             bar.finish_and_clear();
             (sets, name.clone())
         }
         (None, Some(path)) => {
-            a.draw.refuse_with_file(path)?;
+            a.draw.refuse_with_file(path, false)?;
             if a.n.is_some() || a.dim.is_some() {
                 bail!(
                     "-n and --dim apply to --sampler; {} fixes N and d itself",
@@ -92,7 +92,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         optimized_for: optimized_for(a.sampler.as_deref(), &a.draw.params)?,
         source,
         params: a.draw.params.clone(),
-        seed: a.draw.seed,
+        seed: a.draw.seed(),
     };
     let (meta, predicted) = metadata(&sets, provenance, format, a.variance)?;
     if let PredictedVariances::OverBudget { pairs } = predicted {

@@ -10,6 +10,6 @@ mod report;
 mod run;
 mod spec;
 
-pub use report::write_results;
+pub use report::{remove_other_runs, write_results};
 pub use run::{Cell, Shard, ShardFile, merge_shards, run_items};
 pub use spec::{Experiment, ExperimentError};

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::run::Cell;
+use super::run::{Cell, Shard};
 use super::spec::{Experiment, ExperimentError};
 use crate::integrands;
 use crate::io::write_atomic;
@@ -41,7 +41,7 @@ pub fn write_results(
             c.integrand.clone(),
             c.n.to_string(),
             format!("{:e}", c.variance),
-            format!("{:e}", c.stderr),
+            c.stderr.map_or(String::new(), |s| format!("{s:e}")),
             c.method.clone(),
             e.sets.to_string(),
         ])
@@ -104,7 +104,10 @@ pub fn write_results(
                         } else {
                             String::new()
                         };
-                        format!("{:.4e} ± {:.1e}{mark}{n}", c.variance, c.stderr)
+                        let err = c
+                            .stderr
+                            .map_or("± unknown (1 set)".into(), |s| format!("± {s:.1e}"));
+                        format!("{:.4e} {err}{mark}{n}", c.variance)
                     })
             },
         );
@@ -182,3 +185,42 @@ pub fn write_results(
         .map_err(|err| fail("README.md", err.to_string()))?;
     Ok(md)
 }
+
+/// Removes what a run of the other kind left in `out`, so a folder never
+/// holds tables and shards of different runs side by side: a whole run
+/// (`shard` None) removes every `shard-*-of-*.json`; a shard run of a
+/// split into n removes the tables (README.md, variances.csv, slopes.csv:
+/// `merge` writes them again) and shards of other splits. Other files are
+/// left alone.
+///
+/// # Errors
+/// The first file that could not be removed.
+pub fn remove_other_runs(out: &Path, shard: Option<Shard>) -> Result<(), ExperimentError> {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return Ok(());
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let split = name
+            .strip_prefix("shard-")
+            .and_then(|r| r.strip_suffix(".json"))
+            .and_then(|r| r.split_once("-of-"))
+            .and_then(|(_, n)| n.parse::<usize>().ok());
+        let stale = match (shard, split) {
+            (None, Some(_)) => true,
+            (Some(s), Some(n)) => n != s.count,
+            (Some(_), None) => TABLES.contains(&name.as_str()),
+            (None, None) => false,
+        };
+        if stale {
+            std::fs::remove_file(entry.path()).map_err(|err| ExperimentError::Invalid {
+                file: out.display().to_string(),
+                reason: format!("removing the earlier run's {name}: {err}"),
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// The files a whole run (or `merge`) writes.
+const TABLES: [&str; 3] = ["README.md", "variances.csv", "slopes.csv"];

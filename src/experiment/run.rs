@@ -27,8 +27,8 @@ pub struct Cell {
     pub n: usize,
     /// Mean predicted variance over the sets.
     pub variance: f64,
-    /// Its standard error.
-    pub stderr: f64,
+    /// Its standard error; `None` from a single set (unknown, not 0).
+    pub stderr: Option<f64>,
     /// `spatial` or `fourier`.
     pub method: String,
 }
@@ -134,7 +134,7 @@ pub fn run_items(
                 requested,
                 n,
                 variance: p.variance,
-                stderr: p.stderr,
+                stderr: (e.sets >= 2).then_some(p.stderr),
                 method: p.method.to_string(),
             });
             on_cell();

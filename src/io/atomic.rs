@@ -6,7 +6,13 @@
 //! Only regular files are replaced. A symbolic link is followed (its target
 //! is written, the link stays); a device, FIFO or socket is written in place
 //! (`-o /dev/null` must not replace /dev/null); a folder is refused.
+//!
+//! [`all_or_nothing`] groups a command's outputs: inside it every write is
+//! staged (temporary files written and synced, device bytes held in
+//! memory) and nothing appears until the group succeeds; when any output or
+//! the work fails, no output is written.
 
+use std::cell::RefCell;
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -24,6 +30,139 @@ pub struct WriteError {
 }
 
 static COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// An output written but not yet made visible (inside [`all_or_nothing`]).
+enum Staged {
+    /// A temporary file to rename over `target`.
+    Rename {
+        path: PathBuf,
+        tmp: PathBuf,
+        target: PathBuf,
+    },
+    /// Bytes for a device, FIFO or socket, written in place at the end.
+    InPlace {
+        path: PathBuf,
+        target: PathBuf,
+        bytes: Vec<u8>,
+    },
+}
+
+thread_local! {
+    /// The outputs staged by the innermost active [`all_or_nothing`] on
+    /// this thread (`None` outside one: writes are immediate).
+    static STAGED: RefCell<Option<Vec<Staged>>> = const { RefCell::new(None) };
+}
+
+/// Runs `work` with every [`write_atomic`] on this thread staged, and makes
+/// the outputs visible only when `work` succeeds: device bytes are written
+/// first (the writes that can still fail, e.g. a full device), then the
+/// temporary files are renamed over their destinations. When `work` or a
+/// staged write fails, every temporary is removed and no output changes
+/// (a device written before a later one failed is the exception: device
+/// bytes cannot be taken back). Nested calls join the outermost group.
+///
+/// # Errors
+/// The error of `work`, or the [`WriteError`] of the output that could not
+/// be made visible.
+pub fn all_or_nothing<T, E: From<WriteError>>(work: impl FnOnce() -> Result<T, E>) -> Result<T, E> {
+    if STAGED.with(|s| s.borrow().is_some()) {
+        return work();
+    }
+    STAGED.with(|s| *s.borrow_mut() = Some(Vec::new()));
+    let result = work();
+    let staged = STAGED.with(|s| s.borrow_mut().take()).unwrap_or_default();
+    let value = match result {
+        Ok(value) => value,
+        Err(e) => {
+            discard(&staged);
+            return Err(e);
+        }
+    };
+    for item in &staged {
+        if let Staged::InPlace {
+            path,
+            target,
+            bytes,
+        } = item
+            && let Err(cause) = write_in_place(target, |w| w.write_all(bytes))
+        {
+            discard(&staged);
+            return Err(WriteError {
+                path: path.clone(),
+                cause,
+            }
+            .into());
+        }
+    }
+    for (i, item) in staged.iter().enumerate() {
+        if let Staged::Rename { path, tmp, target } = item
+            && let Err(cause) = fs::rename(tmp, target).and_then(|()| sync_folder(target))
+        {
+            discard(&staged[i..]);
+            return Err(WriteError {
+                path: path.clone(),
+                cause,
+            }
+            .into());
+        }
+    }
+    Ok(value)
+}
+
+/// [`write_atomic`] made visible at once even inside [`all_or_nothing`]:
+/// for files that must survive the command being killed (a checkpoint).
+///
+/// # Errors
+/// As [`write_atomic`].
+pub fn write_atomic_now<F>(path: &Path, write: F) -> Result<(), WriteError>
+where
+    F: FnOnce(&mut dyn Write) -> io::Result<()>,
+{
+    let outer = STAGED.with(|s| s.borrow_mut().take());
+    let result = write_atomic(path, write);
+    STAGED.with(|s| *s.borrow_mut() = outer);
+    result
+}
+
+/// The bytes of an output this thread wrote: its staged temporary inside
+/// [`all_or_nothing`] (the destination does not hold them yet), else the
+/// file itself.
+///
+/// # Errors
+/// The I/O error of reading it.
+pub fn read_output(path: &Path) -> io::Result<Vec<u8>> {
+    let target = resolve_links(path)?;
+    let staged = STAGED.with(|s| {
+        s.borrow().as_ref().and_then(|list| {
+            list.iter().rev().find_map(|item| match item {
+                Staged::Rename { tmp, target: t, .. } if *t == target => Some(tmp.clone()),
+                _ => None,
+            })
+        })
+    });
+    fs::read(staged.unwrap_or(target))
+}
+
+/// Removes the temporary files of staged outputs.
+fn discard(staged: &[Staged]) {
+    for item in staged {
+        if let Staged::Rename { tmp, .. } = item {
+            let _ = fs::remove_file(tmp);
+        }
+    }
+}
+
+fn staging() -> bool {
+    STAGED.with(|s| s.borrow().is_some())
+}
+
+fn stage(item: Staged) {
+    STAGED.with(|s| {
+        if let Some(list) = s.borrow_mut().as_mut() {
+            list.push(item);
+        }
+    });
+}
 
 /// Writes `path` atomically with the bytes `write` produces.
 ///
@@ -45,7 +184,21 @@ where
                 "it is a folder; give a file name inside it",
             )));
         }
-        Ok(meta) if !meta.is_file() => return write_in_place(&target, write).map_err(fail),
+        Ok(meta) if !meta.is_file() => {
+            if staging() {
+                let mut bytes = Vec::new();
+                write(&mut bytes).map_err(fail)?;
+                // Refuse now what cannot be opened, before the group ends.
+                probe_in_place(&target, &meta).map_err(fail)?;
+                stage(Staged::InPlace {
+                    path: path.to_path_buf(),
+                    target,
+                    bytes,
+                });
+                return Ok(());
+            }
+            return write_in_place(&target, write).map_err(fail);
+        }
         _ => {}
     }
     remove_stale_temporaries(&target);
@@ -56,17 +209,32 @@ where
         write(&mut out)?;
         let file = out.into_inner().map_err(|e| e.into_error())?;
         file.sync_all()?;
+        if staging() {
+            return Ok(true);
+        }
         fs::rename(&tmp, &target)?;
-        sync_folder(&target)
+        sync_folder(&target).map(|()| false)
     })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
+    match result {
+        Ok(true) => {
+            stage(Staged::Rename {
+                path: path.to_path_buf(),
+                tmp,
+                target,
+            });
+            Ok(())
+        }
+        Ok(false) => Ok(()),
+        Err(cause) => {
+            let _ = fs::remove_file(&tmp);
+            Err(fail(cause))
+        }
     }
-    result.map_err(fail)
 }
 
-/// Checks, before any work, that `path` can be written: its folder exists
-/// and it is not a folder itself.
+/// Checks, before any work, that `path` can be written: its folder exists,
+/// it is not a folder itself, and a file can be created there (or the
+/// device opened).
 ///
 /// # Errors
 /// [`WriteError`] naming `path` and what is wrong.
@@ -84,10 +252,26 @@ pub fn check_output(path: &Path) -> Result<(), WriteError> {
     }
     match target.parent().filter(|d| !d.as_os_str().is_empty()) {
         Some(dir) if !dir.is_dir() => {
-            Err(fail(format!("the folder {} does not exist", dir.display())))
+            return Err(fail(format!("the folder {} does not exist", dir.display())));
         }
-        _ => Ok(()),
+        _ => {}
     }
+    // Probe: the destination (a device) opens for writing, or a file can be
+    // created beside it (a read-only or virtual file system refuses here,
+    // before the work, rather than after it).
+    let probe = match fs::metadata(&target) {
+        Ok(meta) if !meta.is_file() => probe_in_place(&target, &meta),
+        _ => {
+            let tmp = temporary_sibling(&target);
+            let created = File::create(&tmp).map(drop);
+            let _ = fs::remove_file(&tmp);
+            created
+        }
+    };
+    probe.map_err(|cause| WriteError {
+        path: path.to_path_buf(),
+        cause,
+    })
 }
 
 /// Follows symbolic links (up to 32) to the path that will be written; a
@@ -107,6 +291,22 @@ fn resolve_links(path: &Path) -> io::Result<PathBuf> {
         }
     }
     Err(io::Error::other("too many levels of symbolic links"))
+}
+
+/// Checks that a device opens for writing. A FIFO or socket is not
+/// opened: opening a FIFO for writing waits for a reader.
+fn probe_in_place(target: &Path, meta: &fs::Metadata) -> io::Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let kind = meta.file_type();
+        if kind.is_fifo() || kind.is_socket() {
+            return Ok(());
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = meta;
+    fs::OpenOptions::new().write(true).open(target).map(drop)
 }
 
 /// Writes a device, FIFO or socket directly.
@@ -232,6 +432,26 @@ mod tests {
                 "/dev/null was replaced"
             );
         }
+        // A FIFO is written in place (a reader gets the bytes) and stays a
+        // FIFO.
+        #[cfg(unix)]
+        if std::process::Command::new("mkfifo")
+            .arg(dir.join("pipe"))
+            .status()
+            .is_ok_and(|s| s.success())
+        {
+            use std::os::unix::fs::FileTypeExt;
+            let pipe = dir.join("pipe");
+            let reader = {
+                let pipe = pipe.clone();
+                std::thread::spawn(move || fs::read(pipe).unwrap())
+            };
+            check_output(&pipe).unwrap();
+            write_atomic(&pipe, |w| w.write_all(b"through")).unwrap();
+            assert_eq!(reader.join().unwrap(), b"through");
+            assert!(fs::metadata(&pipe).unwrap().file_type().is_fifo());
+            fs::remove_file(&pipe).unwrap();
+        }
         // A temporary left by a process that no longer runs is removed by
         // the next write to the same file; pid 4194304 is above Linux's
         // largest pid.
@@ -256,6 +476,64 @@ mod tests {
                 .contains("does not exist")
         );
         check_output(&dir.join("fresh.csv")).unwrap();
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_group_of_outputs_appears_whole_or_not_at_all() {
+        let dir = std::env::temp_dir().join(format!("varspec-atomic-group-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("a.txt"), dir.join("b.txt"));
+        fs::write(&a, b"old a").unwrap();
+        // The second output fails: the first keeps its old bytes.
+        let failed: Result<(), WriteError> = all_or_nothing(|| {
+            write_atomic(&a, |w| w.write_all(b"new a"))?;
+            assert_eq!(read_output(&a).unwrap(), b"new a", "staged bytes");
+            assert_eq!(fs::read(&a).unwrap(), b"old a", "visible too early");
+            write_atomic(&b, |_| Err(io::Error::other("boom")))
+        });
+        assert!(failed.unwrap_err().to_string().contains("boom"));
+        assert_eq!(fs::read(&a).unwrap(), b"old a");
+        assert!(!b.exists());
+        // The work fails after both were written: neither appears.
+        let failed: Result<(), WriteError> = all_or_nothing(|| {
+            write_atomic(&a, |w| w.write_all(b"new a"))?;
+            write_atomic(&b, |w| w.write_all(b"new b"))?;
+            Err(WriteError {
+                path: dir.clone(),
+                cause: io::Error::other("later work failed"),
+            })
+        });
+        assert!(failed.is_err());
+        assert_eq!(fs::read(&a).unwrap(), b"old a");
+        assert!(!b.exists());
+        // A device that fails when written (Linux's /dev/full) stops the
+        // group before any file is renamed.
+        let full = Path::new("/dev/full");
+        if full.exists() {
+            let failed: Result<(), WriteError> = all_or_nothing(|| {
+                write_atomic(&a, |w| w.write_all(b"new a"))?;
+                write_atomic(full, |w| w.write_all(b"bytes"))
+            });
+            assert!(failed.unwrap_err().to_string().contains("/dev/full"));
+            assert_eq!(fs::read(&a).unwrap(), b"old a");
+        }
+        // Success: both appear; a checkpoint written inside appears at once.
+        let ckpt = dir.join("c.txt");
+        all_or_nothing(|| {
+            write_atomic(&a, |w| w.write_all(b"new a"))?;
+            write_atomic_now(&ckpt, |w| w.write_all(b"now"))?;
+            assert_eq!(fs::read(&ckpt).unwrap(), b"now");
+            write_atomic(&b, |w| w.write_all(b"new b"))
+        })
+        .unwrap();
+        assert_eq!(fs::read(&a).unwrap(), b"new a");
+        assert_eq!(fs::read(&b).unwrap(), b"new b");
+        let names: Vec<String> = fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 3, "temporaries left behind: {names:?}");
         fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -8,14 +8,13 @@
 //! f64: x, m, v, best x (N·d each), scores, losses, seconds. Scalars that
 //! may be infinite or NaN travel as the bits of their f64.
 
-use std::fs;
 use std::io;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
 use super::adam::AdamState;
-use crate::io::{WriteError, write_atomic};
+use crate::io::{WriteError, write_atomic_now};
 
 const MAGIC: &str = "varspec-checkpoint 1";
 
@@ -84,7 +83,7 @@ pub fn save(path: &Path, run: &str, state: &AdamState) -> Result<(), WriteError>
         scores: state.scores.len(),
         losses: state.losses.len(),
     };
-    write_atomic(path, |w| {
+    write_atomic_now(path, |w| {
         writeln!(w, "{MAGIC}")?;
         serde_json::to_writer(&mut *w, &header)?;
         writeln!(w)?;
@@ -115,7 +114,20 @@ pub fn save(path: &Path, run: &str, state: &AdamState) -> Result<(), WriteError>
 /// file's size is checked against its header before anything is allocated.
 pub fn load(path: &Path, run: &str) -> Result<Option<AdamState>, CheckpointError> {
     let name = path.display().to_string();
-    let bytes = match fs::read(path) {
+    // A checkpoint is a regular file this tool wrote (not a device such as
+    // /dev/zero) holding the points and two moment vectors: never more
+    // than the memory budget.
+    match std::fs::metadata(path) {
+        Ok(meta) if !meta.is_file() => {
+            return Err(CheckpointError::Read {
+                path: name,
+                cause: io::Error::other("not a regular file: not a varspec checkpoint"),
+            });
+        }
+        _ => {}
+    }
+    let limit = crate::memory::limit_mib().saturating_mul(1 << 20);
+    let bytes = match crate::io::read_bounded(path, limit, "a varspec checkpoint") {
         Ok(b) => b,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(None),
         Err(cause) => return Err(CheckpointError::Read { path: name, cause }),

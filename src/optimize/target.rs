@@ -171,7 +171,8 @@ fn interpolate(table: &[(f64, f64)], k: f64) -> f64 {
 }
 
 fn read_radial(path: &Path) -> Result<Vec<(f64, f64)>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let text = crate::io::read_text_bounded(path, 64 << 20, "a radial weight table")
+        .map_err(|e| format!("{}: {e}", path.display()))?;
     let mut lines = text
         .lines()
         .enumerate()

@@ -132,6 +132,15 @@ pub enum SamplerError {
         /// The offending part.
         part: String,
     },
+    /// The same parameter given twice in one place (the spec's shorthand,
+    /// or the --param list).
+    #[error("sampler `{spec}`: parameter `{key}` is given twice (each once)")]
+    RepeatedParam {
+        /// The sampler spec.
+        spec: String,
+        /// The repeated key.
+        key: String,
+    },
     /// A parameter the sampler does not have.
     #[error("{sampler}: unknown parameter `{key}`; its parameters: {known}")]
     UnknownParam {

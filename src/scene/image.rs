@@ -45,7 +45,9 @@ impl GreyImage {
     /// # Errors
     /// A sentence naming what is wrong with the file.
     pub fn read_pfm(path: &Path) -> Result<GreyImage, String> {
-        let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let limit = crate::memory::limit_mib().saturating_mul(1 << 20);
+        let bytes = crate::io::read_bounded(path, limit, "a PFM image")
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         let bad = |what: &str| format!("{}: not a grey PFM image: {what}", path.display());
         // Three whitespace-separated header tokens after `Pf`, then one
         // whitespace byte, then the data.

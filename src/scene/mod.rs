@@ -159,10 +159,13 @@ impl Scene {
                 known: BUILTIN_SCENES.map(|s| s.0).join(", "),
             });
         }
-        let text = std::fs::read_to_string(path).map_err(|cause| SceneError::Io {
-            path: name_or_path.into(),
-            cause,
-        })?;
+        let text =
+            crate::io::read_text_bounded(path, 64 << 20, "a scene file").map_err(|cause| {
+                SceneError::Io {
+                    path: name_or_path.into(),
+                    cause,
+                }
+            })?;
         let folder = path.parent().unwrap_or(std::path::Path::new(""));
         Scene::build(&text, name_or_path, folder, BvhKind::Bvh2)
     }

@@ -26,7 +26,7 @@ fn embed(value: &mut Value, folder: &Path) -> Result<(), TourError> {
             if let (Some(Value::String(file)), true) =
                 (map.get("file"), map.contains_key("caption"))
             {
-                let bytes = std::fs::read(folder.join(file.as_str())).map_err(fail)?;
+                let bytes = crate::io::read_output(&folder.join(file.as_str())).map_err(fail)?;
                 let data = base64::engine::general_purpose::STANDARD.encode(bytes);
                 map.insert(
                     "data".into(),

@@ -101,12 +101,13 @@ pub fn write_fixtures(dir: &Path) {
             r#"{{"name": "{name}", "samplers": ["jitter"], "integrands": [{integrands}], "n": [{n}], "sets": 2}}"#
         )
     };
-    let files: [(&str, Vec<u8>); 9] = [
+    let files: [(&str, Vec<u8>); 10] = [
         ("p.csv", points.into_bytes()),
         ("long-line.csv", vec![b'0'; (1 << 20) + 10]),
         ("bom.csv", "\u{feff}x0,x1\n0.1,0.2\n".into()),
         ("bom-bad-header.csv", "\u{feff}x,y\n0.1,0.2\n".into()),
         ("huge-weights.csv", "k,weight\n1,1e308\n2,1e308\n".into()),
+        ("bom-weights.csv", "\u{feff}k,weight\n1,1\n2,0.5\n".into()),
         ("garbage.bin", "garbage\n".into()),
         (
             "escape.json",
