@@ -802,3 +802,47 @@ fn experiment_help_describes_the_file() {
         );
     }
 }
+
+#[test]
+fn a_radial_table_of_huge_weights_is_optimized_not_returned_as_its_start() {
+    // Weights near f64's limit once made the loss overflow and the start
+    // came back as "optimized" (issue: hostile input, part two). Scaled to a
+    // largest weight of 1 the descent must move: its final loss far below
+    // the start's and below jitter's on the same weights.
+    let dir = temp_dir("huge-radial");
+    let table = dir.join("w.csv");
+    std::fs::write(&table, "k,weight\n1,1e200\n4,1e200\n8,1e199\n").unwrap();
+    let (out, report) = (dir.join("o.csv"), dir.join("r.json"));
+    let target = format!("radial:{}", table.display());
+    let run = varspec(&[
+        "optimize",
+        "points",
+        "-n",
+        "64",
+        "--target",
+        &target,
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let curve = r["loss_curve"].as_array().unwrap();
+    let (start, end) = (
+        curve[0].as_f64().unwrap(),
+        curve.last().unwrap().as_f64().unwrap(),
+    );
+    let jitter = r["comparison"]["jitter"]["loss"].as_f64().unwrap();
+    assert!(
+        start.is_finite() && end < start / 10.0,
+        "loss {start} -> {end}"
+    );
+    assert!(end < jitter, "optimized {end} against jitter {jitter}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -117,7 +117,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut points = Vec::new();
     for &requested in &a.ns {
         let (sampler, n) =
-            registry::build_nearest(&a.sampler, requested, Some(dim), &a.draw.params)?;
+            registry::build_nearest(&a.sampler, requested, Some(dim), &a.draw.params).map_err(
+                |e| match e {
+                    varspec::samplers::SamplerError::Dimension { max, .. } if max < dim => {
+                        anyhow::anyhow!(
+                            "{e}: {name} is {dim}-dimensional; use a sampler with {dim}D sets \
+                             (umj, padded:xy=...,uv=..., or jitter, random, sobol, which draw {dim}D sets)"
+                        )
+                    }
+                    e => e.into(),
+                },
+            )?;
         let realization = |r: usize| -> Result<_, VarianceError> {
             Ok(sampler.sample(&mut set_rng(a.draw.seed(), r as u64))?)
         };
