@@ -104,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 exact.push(e.variance);
                 radial.push(r.variance);
             }
-            let (fe, fr) = (fit_slope(&ns, &exact), fit_slope(&ns, &radial));
+            let (fe, fr) = (fit_slope(&ns, &exact)?, fit_slope(&ns, &radial)?);
             let (el, eh) = fe.slope_ci.unwrap_or((f64::NAN, f64::NAN));
             let (rl, rh) = fr.slope_ci.unwrap_or((f64::NAN, f64::NAN));
             slopes.push(Slopes {

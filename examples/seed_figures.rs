@@ -150,7 +150,9 @@ fn main() -> Result<()> {
     }
     let slope = |v: &[(f64, f64)]| {
         let (x, y): (Vec<f64>, Vec<f64>) = v.iter().copied().unzip();
-        fit_slope(&x, &y).slope
+        fit_slope(&x, &y)
+            .expect("positive variances at distinct N")
+            .slope
     };
     let (sb, sa) = (slope(&before), slope(&after));
     let plot = LinePlot {

@@ -61,8 +61,17 @@ pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> 
             options.iters = iters.unwrap_or(1000);
             let optimizer = PointOptimizer::new(c.dim, &target, options)
                 .map_err(|e| c.bad_param("target", e.to_string()))?;
+            // The transform plans and, per thread, one running descent.
+            let plans = crate::spectrum::nufft::nufft_memory_bytes(optimizer.frequencies())
+                .unwrap_or(f64::INFINITY);
+            let threads = rayon::current_num_threads() as f64;
+            crate::memory::check(
+                &format!("blue-noise descents of {} points in {}D", c.n, c.dim),
+                Some(plans + threads * optimizer.descent_bytes(c.n)),
+                "lower -n",
+            )?;
             How::Torus {
-                start: Random::new(c.n, c.dim),
+                start: Random::new(c.n, c.dim)?,
                 optimizer: Box::new(optimizer),
             }
         }

@@ -342,22 +342,15 @@ pub fn build(
     let info = find(name)?;
     let sampler = info.name;
     let dim = dim.unwrap_or(info.dims.default);
-    if dim < info.dims.min || dim > info.dims.max {
-        return Err(SamplerError::Dimension {
-            sampler,
-            dim,
-            min: info.dims.min,
-            max: info.dims.max,
-        });
-    }
-    if n == 0 {
-        return Err(SamplerError::ZeroPoints { sampler });
-    }
-    // Fewer than 2^32 coordinates: point indices then fit a u32 (the
-    // permutations of N-rooks and padded pairing hold u32).
-    if n.checked_mul(dim).is_none_or(|c| c >= 1 << 32) {
-        return Err(SamplerError::TooLarge { sampler, n, dim });
-    }
+    crate::samplers::check_size(sampler, n, dim, info.dims.min..=info.dims.max)?;
+    // One set is held at a time per thread (and one more by the caller):
+    // refuse a single set that does not fit before drawing it.
+    let threads = rayon::current_num_threads() as f64 + 1.0;
+    crate::memory::check(
+        &format!("{sampler}: a set of {n} points in {dim} dimensions, {threads} at a time"),
+        Some(n as f64 * dim as f64 * 8.0 * threads),
+        "lower -n",
+    )?;
     if let Some((key, _)) = params
         .iter()
         .find(|(k, _)| !info.params.iter().any(|p| p.key == k))

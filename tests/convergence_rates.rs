@@ -35,7 +35,7 @@ fn slope_ci(sampler: &str, f: &dyn Integrand) -> (f64, (f64, f64)) {
         });
     }
     let ns: Vec<f64> = ns_used.iter().map(|&n| n as f64).collect();
-    let fit = fit_slope(&ns, &vars);
+    let fit = fit_slope(&ns, &vars).unwrap();
     (fit.slope, fit.slope_ci.unwrap())
 }
 

@@ -200,3 +200,24 @@ fn bad_specs_are_clear_errors() {
         "gaussian:sx=0.2,sy=0.2,angle=0,cx=0.5,cy=0.5"
     );
 }
+
+#[test]
+fn integrand_constructors_refuse_what_their_closed_forms_cannot_hold() {
+    use varspec::integrands::{Cosine, DefocusShape, Gaussian, HalfPlane, Layers};
+    // A negative or NaN deviation gave a negative variance or NaN.
+    assert!(Gaussian::new(-0.1, 0.1, 0.0, [0.5, 0.5]).is_err());
+    assert!(Gaussian::new(f64::NAN, 0.1, 0.0, [0.5, 0.5]).is_err());
+    assert!(Gaussian::new(0.1, 0.6, 0.0, [0.5, 0.5]).is_err());
+    assert!(Gaussian::new(0.1, 0.1, 0.0, [f64::INFINITY, 0.5]).is_err());
+    assert!(Gaussian::new(0.1, 0.05, 30.0, [0.5, 0.5]).is_ok());
+    assert!(HalfPlane::new(f64::NAN, 0.0).is_err());
+    assert!(HalfPlane::new(30.0, 1.5).is_err());
+    assert!(HalfPlane::new(30.0, -0.2).is_ok());
+    // |i64::MIN| wrapped to a negative number and passed the 2^40 check.
+    assert!(Cosine::new([i64::MIN, 0]).is_err());
+    assert!(Cosine::new([3, 1 << 41]).is_err());
+    assert!(Cosine::new([-(1 << 40), 7]).is_ok());
+    // A mix outside [0, 1] gave a variance of 5.15 (not a mixture).
+    assert!(Layers::new(DefocusShape::Disk, 0.3, 0.5, -0.2, 7.0).is_err());
+    assert!(Layers::new(DefocusShape::Disk, 0.3, 0.5, -0.2, 0.5).is_ok());
+}

@@ -22,7 +22,7 @@ fn shifted_variance(f: &dyn integrands::Integrand, set: &PointSet, shifts: usize
         Ok(set.clone())
     })
     .unwrap();
-    (e.variance, (e.ci_high - e.variance) / 1.96)
+    (e.variance, e.stderr)
 }
 
 #[test]

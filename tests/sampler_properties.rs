@@ -258,6 +258,36 @@ fn public_constructors_refuse_what_they_cannot_do() {
     assert!(PoissonDisk::new(100, 2, 1.5, 10).is_err());
     assert!(PoissonDisk::new(100, 5, 0.5, 10).is_err());
     assert!(PoissonDisk::new(100, 2, 0.5, 10).is_ok());
+    // Every sampler's size rule holds for direct construction: N >= 1, its
+    // dimensions, fewer than 2^32 coordinates (Jitter at m = 2^17 in 4D was
+    // a capacity-overflow panic, Random in 0 dimensions a panic at sample).
+    use varspec::samplers::{Jitter, MultiJitter, NRooks, Random, StratumOffset};
+    assert!(matches!(
+        Jitter::new(1 << 17, 4, StratumOffset::Independent),
+        Err(SamplerError::TooLarge { .. })
+    ));
+    assert!(matches!(
+        Jitter::new(4, 5, StratumOffset::Independent),
+        Err(SamplerError::Dimension { .. })
+    ));
+    assert!(Jitter::new(16, 2, StratumOffset::Independent).is_ok());
+    assert!(matches!(
+        Random::new(5, 0),
+        Err(SamplerError::Dimension { .. })
+    ));
+    assert!(matches!(
+        NRooks::new(0, 2),
+        Err(SamplerError::ZeroPoints { .. })
+    ));
+    assert!(matches!(
+        NRooks::new(1 << 31, 2),
+        Err(SamplerError::TooLarge { .. })
+    ));
+    assert!(matches!(
+        MultiJitter::new(1 << 20, 1 << 20, true),
+        Err(SamplerError::TooLarge { .. })
+    ));
+    assert!(MultiJitter::new(4, 8, false).is_ok());
     // Fewer than 2^32 coordinates, so point indices fit a u32.
     assert!(matches!(
         varspec::registry::build("nrooks", 1 << 32, Some(1), &[]),

@@ -63,8 +63,7 @@ fn check(sampler: &dyn Sampler, name: &str, f: &dyn Integrand, sets: usize, seed
     );
     let many = fourier(f, 63, NUFFT_TOL, 200, realization).unwrap();
     let e = empirical(f, if n > 256 { 2000 } else { 4000 }, seed + 1, realization).unwrap();
-    let se_e = (e.ci_high - e.ci_low) / (2.0 * 1.959_964);
-    let combined = (se_e * se_e + many.stderr * many.stderr).sqrt();
+    let combined = (e.stderr * e.stderr + many.stderr * many.stderr).sqrt();
     assert!(
         (e.variance - many.variance).abs() <= Z * combined + many.truncation_bound + nufft,
         "{name} N={n} {}: empirical {:e} [{:e}, {:e}] vs fourier {:e} ± {:e} (bound {:e}): beyond {Z} combined standard errors",

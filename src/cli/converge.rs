@@ -183,7 +183,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let ns: Vec<f64> = points.iter().map(|p| p.n as f64).collect();
     let vars: Vec<f64> = points.iter().map(|p| p.variance).collect();
-    let fit = fit_slope(&ns, &vars);
+    let fit = fit_slope(&ns, &vars)?;
     let theory = match &subject {
         Subject::Torus(f) => theoretical_rate(&a.sampler, f.class(), dim),
         Subject::Square(_) => None,

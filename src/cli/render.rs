@@ -123,19 +123,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.shear_png.as_deref(),
     ])?;
     let scene = Scene::load(&a.scene)?;
-    let sampler = registry::build(&a.sampler, a.spp, Some(4), &a.params).with_context(|| {
-        format!(
-            "--sampler {}: rendering needs a 4D sampler (x, y on the pixel, u, v on the lens or light)",
-            a.sampler
-        )
-    })?;
-    let [w, h] = scene.camera().resolution();
     // Every thread holds one pixel's set (and its sheared copy) at a time.
     varspec::memory::check(
         &format!("{} spp per pixel", a.spp),
         Some(rayon::current_num_threads() as f64 * 2.0 * a.spp as f64 * 4.0 * 8.0),
         "lower --spp",
     )?;
+    let sampler = registry::build(&a.sampler, a.spp, Some(4), &a.params).map_err(|e| match e {
+        varspec::samplers::SamplerError::Dimension { .. } => anyhow::anyhow!(
+            "--sampler {}: rendering needs a 4D sampler (x, y on the pixel, u, v on the lens or light): {e}",
+            a.sampler
+        ),
+        e => e.into(),
+    })?;
+    let [w, h] = scene.camera().resolution();
     let start = Instant::now();
     let analysis = analyse(&scene);
     let shears = pixel_shears(&scene, sampler.as_ref(), policy, &analysis, a.seed)?;

@@ -123,7 +123,9 @@ pub fn write_results(
                 v.dedup();
                 v.len()
             };
-            (vs.iter().all(|&v| v > 0.0) && distinct >= 2).then(|| fit_slope(&ns, &vs))
+            (vs.iter().all(|&v| v > 0.0) && distinct >= 2)
+                .then(|| fit_slope(&ns, &vs).ok())
+                .flatten()
         };
         table(
             &mut md,

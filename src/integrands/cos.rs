@@ -13,9 +13,22 @@ pub struct Cosine {
 }
 
 impl Cosine {
-    /// The cosine of integer frequency k₀.
-    pub fn new(k0: [i64; 2]) -> Self {
-        Cosine { k0 }
+    /// The cosine of integer frequency k₀, |k₀ components| ≤ 2^40.
+    ///
+    /// # Errors
+    /// [`super::IntegrandError::Value`] beyond 2^40 (the phase reduction
+    /// of `k·h` needs the product exact).
+    pub fn new(k0: [i64; 2]) -> Result<Self, super::IntegrandError> {
+        for (key, k) in [("kx", k0[0]), ("ky", k0[1])] {
+            super::require(
+                k.unsigned_abs() <= 1 << 40,
+                "cos",
+                key,
+                k,
+                "an integer in [-2^40, 2^40]",
+            )?;
+        }
+        Ok(Cosine { k0 })
     }
 
     /// cos(2π k₀·h) with exact phase reduction (k₀ may be 4000 or more).

@@ -65,7 +65,7 @@ impl Defocus {
                 })?),
                 DefocusShape::Disk => Box::new(Disk::new(0.5 * size, centre)?),
                 DefocusShape::Gaussian => {
-                    Box::new(Gaussian::new(0.25 * size, 0.25 * size, 0.0, centre))
+                    Box::new(Gaussian::new(0.25 * size, 0.25 * size, 0.0, centre)?)
                 }
             };
         Ok(Defocus { shape, size, c, g })

@@ -34,13 +34,53 @@ pub struct Gaussian {
 
 impl Gaussian {
     /// Standard deviations sx, sy in (0, ½], angle in degrees, centre c.
-    pub fn new(sx: f64, sy: f64, angle: f64, centre: [f64; 2]) -> Self {
+    ///
+    /// # Errors
+    /// [`super::IntegrandError::Value`] for a deviation outside (0, ½] (a
+    /// wider bump overlaps its periodic images beyond what the image sums
+    /// hold; a negative one has no meaning) or a non-finite angle or centre.
+    pub fn new(
+        sx: f64,
+        sy: f64,
+        angle: f64,
+        centre: [f64; 2],
+    ) -> Result<Self, super::IntegrandError> {
+        let deviation = |s: f64| s > 0.0 && s <= 0.5;
+        let name = "gaussian";
+        super::require(
+            deviation(sx),
+            name,
+            "sx",
+            sx,
+            "a standard deviation in (0, 0.5]",
+        )?;
+        super::require(
+            deviation(sy),
+            name,
+            "sy",
+            sy,
+            "a standard deviation in (0, 0.5]",
+        )?;
+        super::require(
+            angle.is_finite(),
+            name,
+            "angle",
+            angle,
+            "an angle in degrees",
+        )?;
+        super::require(
+            centre.iter().all(|c| c.is_finite()),
+            name,
+            "cx/cy",
+            centre,
+            "a finite centre",
+        )?;
         let (s, c) = angle.to_radians().sin_cos();
         let smax = sx.max(sy);
         // Autocorrelation images reach √2·s·√(4·CUTOFF)… beyond which terms vanish.
         let images = ((2.0 * CUTOFF).sqrt() * std::f64::consts::SQRT_2 * smax).ceil() as i64 + 1;
         let fourier_autocov = 4.0 * std::f64::consts::PI * sx * sy > 0.5;
-        Gaussian {
+        Ok(Gaussian {
             sx,
             sy,
             angle,
@@ -49,7 +89,7 @@ impl Gaussian {
             e2: [-s, c],
             images,
             fourier_autocov,
-        }
+        })
     }
 
     /// The quadratic form a²/sx² + b²/sy² of offset u.

@@ -29,8 +29,27 @@ pub struct HalfPlane {
 }
 
 impl HalfPlane {
-    /// The half-plane at `angle` degrees and signed `offset` from the centre.
-    pub fn new(angle: f64, offset: f64) -> Self {
+    /// The half-plane at `angle` degrees and signed `offset` ∈ [−1, 1]
+    /// from the centre.
+    ///
+    /// # Errors
+    /// [`super::IntegrandError::Value`] for a non-finite angle or an offset
+    /// outside [−1, 1] (beyond, the half-plane misses or covers the square).
+    pub fn new(angle: f64, offset: f64) -> Result<Self, super::IntegrandError> {
+        super::require(
+            angle.is_finite(),
+            "halfplane",
+            "angle",
+            angle,
+            "an angle in degrees",
+        )?;
+        super::require(
+            offset.abs() <= 1.0,
+            "halfplane",
+            "offset",
+            offset,
+            "an offset in [-1, 1]",
+        )?;
         let (s, c) = angle.to_radians().sin_cos();
         let n = [c, s];
         let level = 0.5 * (c + s) + offset;
@@ -47,14 +66,14 @@ impl HalfPlane {
             })
             .filter(|(_, t)| t[0] != 0.0 || t[1] != 0.0)
             .collect();
-        HalfPlane {
+        Ok(HalfPlane {
             angle,
             offset,
             n,
             level,
             edges,
             area,
-        }
+        })
     }
 }
 

@@ -25,7 +25,7 @@ impl Layers {
     /// weight `mix` ∈ [0, 1].
     ///
     /// # Errors
-    /// As [`Defocus::new`].
+    /// As [`Defocus::new`]; a `mix` outside [0, 1].
     pub fn new(
         shape: DefocusShape,
         size: f64,
@@ -33,6 +33,13 @@ impl Layers {
         c2: f64,
         mix: f64,
     ) -> Result<Self, super::IntegrandError> {
+        super::require(
+            (0.0..=1.0).contains(&mix),
+            "layers",
+            "mix",
+            mix,
+            "a weight in [0, 1]",
+        )?;
         Ok(Layers {
             layers: [
                 Defocus::new(shape, size, c1)?,

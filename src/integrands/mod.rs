@@ -139,6 +139,26 @@ pub enum IntegrandError {
 
 /// x reduced to its nearest periodic image, in [−½, ½].
 #[inline]
+/// `Ok` when `ok`, else [`IntegrandError::Value`] naming the integrand,
+/// the key, the value and what was expected: the constructors' checks.
+pub(crate) fn require(
+    ok: bool,
+    integrand: &'static str,
+    key: &'static str,
+    value: impl std::fmt::Debug,
+    expected: &str,
+) -> Result<(), IntegrandError> {
+    if ok {
+        return Ok(());
+    }
+    Err(IntegrandError::Value {
+        integrand,
+        key,
+        value: format!("{value:?}"),
+        expected: expected.into(),
+    })
+}
+
 pub(crate) fn nearest_image(x: f64) -> f64 {
     x - x.round()
 }

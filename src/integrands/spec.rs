@@ -160,7 +160,7 @@ impl Params {
         self.text(key)
             .parse::<i64>()
             .ok()
-            .filter(|v| v.abs() <= 1 << 40)
+            .filter(|v| v.unsigned_abs() <= 1 << 40)
             .ok_or_else(|| self.bad(key, "an integer (the integrand must be periodic)"))
     }
 
@@ -232,7 +232,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
     let unit = |v: f64| v > 0.0 && v <= 1.0;
     let size = |v: f64| (super::defocus::MIN_SIZE..=1.0).contains(&v);
     Ok(match info.name {
-        "cos" => Box::new(Cosine::new([p.integer("kx")?, p.integer("ky")?])),
+        "cos" => Box::new(Cosine::new([p.integer("kx")?, p.integer("ky")?])?),
         "disk" => Box::new(Disk::new(
             p.number("r", |r| r > 0.0 && r <= 0.5, "a radius in (0, 0.5]")?,
             p.centre()?,
@@ -267,12 +267,12 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
                 sy,
                 p.number("angle", |_| true, "an angle in degrees")?,
                 p.centre()?,
-            ))
+            )?)
         }
         "halfplane" => Box::new(HalfPlane::new(
             p.number("angle", |_| true, "an angle in degrees")?,
             p.number("offset", |o| o.abs() <= 1.0, "an offset in [-1, 1]")?,
-        )),
+        )?),
         "defocus" => Box::new(Defocus::new(
             p.shape()?,
             p.number("size", size, "a size in [1e-4, 1]")?,

@@ -37,9 +37,17 @@ pub struct Jitter {
 }
 
 impl Jitter {
-    /// The m^d grid in d dimensions with the given offset rule.
-    pub fn new(m: usize, dim: usize, offset: StratumOffset) -> Self {
-        Jitter { m, dim, offset }
+    /// The m^d grid in d dimensions (1 to 4) with the given offset rule.
+    ///
+    /// # Errors
+    /// As [`super::check_size`] for N = m^d.
+    pub fn new(m: usize, dim: usize, offset: StratumOffset) -> Result<Self, SamplerError> {
+        let n = u32::try_from(dim)
+            .ok()
+            .and_then(|d| m.checked_pow(d))
+            .unwrap_or(usize::MAX);
+        super::check_size("jitter", n, dim, 1..=4)?;
+        Ok(Jitter { m, dim, offset })
     }
 
     /// Strata per axis.
@@ -55,7 +63,7 @@ fn from_config(c: &Config, offset: StratumOffset) -> Result<Box<dyn Sampler>, Sa
         let above = Some(pow_saturating(m + 1, c.dim)).filter(|&a| a != usize::MAX);
         return Err(c.bad_count("N = m^d", below, above));
     }
-    Ok(Box::new(Jitter::new(m, c.dim, offset)))
+    Ok(Box::new(Jitter::new(m, c.dim, offset)?))
 }
 
 pub(crate) fn regular_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {

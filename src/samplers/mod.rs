@@ -190,6 +190,36 @@ fn nearest(below: Option<usize>, above: Option<usize>) -> String {
     }
 }
 
+/// Checks what every sampler needs of its size: N ≥ 1, d in `dims`, and
+/// fewer than 2^32 coordinates (point indices then fit a u32: the
+/// permutations of N-rooks and multi-jitter hold u32).
+///
+/// # Errors
+/// [`SamplerError::ZeroPoints`], [`SamplerError::Dimension`] or
+/// [`SamplerError::TooLarge`] naming `sampler`.
+pub fn check_size(
+    sampler: &'static str,
+    n: usize,
+    dim: usize,
+    dims: std::ops::RangeInclusive<usize>,
+) -> Result<(), SamplerError> {
+    if !dims.contains(&dim) {
+        return Err(SamplerError::Dimension {
+            sampler,
+            dim,
+            min: *dims.start(),
+            max: *dims.end(),
+        });
+    }
+    if n == 0 {
+        return Err(SamplerError::ZeroPoints { sampler });
+    }
+    if n.checked_mul(dim).is_none_or(|c| c >= 1 << 32) {
+        return Err(SamplerError::TooLarge { sampler, n, dim });
+    }
+    Ok(())
+}
+
 /// Draws `sets` realizations of `sampler` in parallel; realization r uses
 /// the stream [`set_rng`]`(seed, r)`. `on_set_done` is called once per
 /// finished set (for progress display).

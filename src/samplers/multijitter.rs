@@ -29,12 +29,18 @@ pub struct MultiJitter {
 
 impl MultiJitter {
     /// `columns` × `rows` strata; `correlated` selects Kensler's CMJ.
-    pub fn new(columns: usize, rows: usize, correlated: bool) -> Self {
-        MultiJitter {
+    ///
+    /// # Errors
+    /// As [`super::check_size`] for N = columns·rows in 2D.
+    pub fn new(columns: usize, rows: usize, correlated: bool) -> Result<Self, SamplerError> {
+        let n = columns.saturating_mul(rows);
+        let name = if correlated { "cmj" } else { "multijitter" };
+        super::check_size(name, n, 2, 2..=2)?;
+        Ok(MultiJitter {
             columns,
             rows,
             correlated,
-        }
+        })
     }
 
     /// The grid (m, n) used for N points: m = `columns` if given, else the
@@ -93,12 +99,12 @@ impl MultiJitter {
 
 pub(crate) fn multijitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let (m, n) = MultiJitter::grid(c)?;
-    Ok(Box::new(MultiJitter::new(m, n, false)))
+    Ok(Box::new(MultiJitter::new(m, n, false)?))
 }
 
 pub(crate) fn cmj_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let (m, n) = MultiJitter::grid(c)?;
-    Ok(Box::new(MultiJitter::new(m, n, true)))
+    Ok(Box::new(MultiJitter::new(m, n, true)?))
 }
 
 impl Sampler for MultiJitter {

@@ -17,13 +17,17 @@ pub struct NRooks {
 
 impl NRooks {
     /// N points in d dimensions.
-    pub fn new(n: usize, dim: usize) -> Self {
-        NRooks { n, dim }
+    ///
+    /// # Errors
+    /// As [`super::check_size`].
+    pub fn new(n: usize, dim: usize) -> Result<Self, SamplerError> {
+        super::check_size("nrooks", n, dim, 1..=usize::MAX)?;
+        Ok(NRooks { n, dim })
     }
 }
 
 pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
-    Ok(Box::new(NRooks::new(c.n, c.dim)))
+    Ok(Box::new(NRooks::new(c.n, c.dim)?))
 }
 
 impl Sampler for NRooks {

@@ -51,8 +51,10 @@ pub(crate) fn umj_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerErr
         _ => return Err(c.bad_param("pairs", "mj or cmj")),
     };
     let (m, n) = MultiJitter::grid(c)?;
-    let half = || Box::new(MultiJitter::new(m, n, correlated)) as Box<dyn Sampler>;
-    Ok(Box::new(Padded::new(half(), half())?))
+    let half = || -> Result<Box<dyn Sampler>, SamplerError> {
+        Ok(Box::new(MultiJitter::new(m, n, correlated)?))
+    };
+    Ok(Box::new(Padded::new(half()?, half()?)?))
 }
 
 pub(crate) fn padded_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {

@@ -18,13 +18,17 @@ pub struct Random {
 
 impl Random {
     /// N uniform points in d dimensions.
-    pub fn new(n: usize, dim: usize) -> Self {
-        Random { n, dim }
+    ///
+    /// # Errors
+    /// As [`super::check_size`].
+    pub fn new(n: usize, dim: usize) -> Result<Self, SamplerError> {
+        super::check_size("random", n, dim, 1..=usize::MAX)?;
+        Ok(Random { n, dim })
     }
 }
 
 pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
-    Ok(Box::new(Random::new(c.n, c.dim)))
+    Ok(Box::new(Random::new(c.n, c.dim)?))
 }
 
 impl Sampler for Random {

@@ -228,6 +228,10 @@ pub enum SceneError {
 /// The largest image side accepted (pixels).
 pub const MAX_SIDE: usize = 16384;
 
+/// Bytes a render holds per pixel (analysis, shear, image, variance maps),
+/// an upper bound checked against the memory budget when a scene is read.
+const PIXEL_BYTES: f64 = 256.0;
+
 impl SceneFile {
     /// Parses and checks a scene; `source_name` names it in errors.
     ///
@@ -258,6 +262,20 @@ impl SceneFile {
                     &format!("an integer from 1 to {MAX_SIDE}"),
                 ));
             }
+        }
+        // A render holds per pixel its analysis, its shear, the image and
+        // the variance maps: 256 bytes a pixel is an ample bound.
+        let [w, h] = c.resolution;
+        if let Err(e) = crate::memory::check(
+            &format!("a {w} x {h} image"),
+            Some(w as f64 * h as f64 * PIXEL_BYTES),
+            "lower camera.resolution",
+        ) {
+            return Err(bad(
+                "camera.resolution".into(),
+                format!("[{w}, {h}]"),
+                &e.to_string(),
+            ));
         }
         if !(c.fov_degrees > 0.0 && c.fov_degrees < 180.0) {
             return Err(bad(

@@ -29,18 +29,40 @@ fn t975(dof: usize) -> f64 {
         .unwrap_or(1.96 + 2.4 / dof as f64)
 }
 
-/// Least-squares fit of log(var) on log(n). Points with non-positive
-/// variance are not allowed.
+/// Why no slope can be fitted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("no convergence slope: {0}")]
+pub struct SlopeError(String);
+
+/// Least-squares fit of log(var) on log(n).
 ///
-/// # Panics
-/// With fewer than two points or a non-positive value (callers check).
-pub fn fit_slope(ns: &[f64], vars: &[f64]) -> SlopeFit {
-    assert!(
-        ns.len() >= 2
-            && ns.len() == vars.len()
-            && vars.iter().all(|&v| v > 0.0)
-            && ns.iter().all(|&n| n > 0.0)
-    );
+/// # Errors
+/// [`SlopeError`] for lists of different lengths, fewer than two distinct
+/// N (the slope is undefined), or an N or a variance that is not a finite
+/// positive number (its logarithm is undefined).
+pub fn fit_slope(ns: &[f64], vars: &[f64]) -> Result<SlopeFit, SlopeError> {
+    if ns.len() != vars.len() {
+        return Err(SlopeError(format!(
+            "{} N values against {} variances",
+            ns.len(),
+            vars.len()
+        )));
+    }
+    if let Some(v) = ns
+        .iter()
+        .chain(vars)
+        .find(|v| !(v.is_finite() && **v > 0.0))
+    {
+        return Err(SlopeError(format!(
+            "{v} is not a positive number (N and variances are fitted on a log scale)"
+        )));
+    }
+    if ns.iter().all(|&n| n == ns[0]) {
+        return Err(SlopeError(format!(
+            "fewer than two distinct N ({:?})",
+            ns.first()
+        )));
+    }
     let x: Vec<f64> = ns.iter().map(|n| n.ln()).collect();
     let y: Vec<f64> = vars.iter().map(|v| v.ln()).collect();
     let m = x.len() as f64;
@@ -59,11 +81,11 @@ pub fn fit_slope(ns: &[f64], vars: &[f64]) -> SlopeFit {
         let t = t975(x.len() - 2);
         (slope - t * se, slope + t * se)
     });
-    SlopeFit {
+    Ok(SlopeFit {
         slope,
         slope_ci,
         intercept,
-    }
+    })
 }
 
 /// The theoretical variance rate (exponent of N) of `sampler` on an
@@ -97,7 +119,7 @@ mod tests {
     fn exact_power_law_has_its_slope_and_a_tight_interval() {
         let ns = [64.0, 256.0, 1024.0, 4096.0];
         let vars: Vec<f64> = ns.iter().map(|n: &f64| 3.0 * n.powf(-1.5)).collect();
-        let fit = fit_slope(&ns, &vars);
+        let fit = fit_slope(&ns, &vars).unwrap();
         assert!((fit.slope + 1.5).abs() < 1e-12);
         let (lo, hi) = fit.slope_ci.unwrap();
         assert!(lo <= -1.5 + 1e-9 && hi >= -1.5 - 1e-9 && hi - lo < 1e-9);
@@ -112,9 +134,25 @@ mod tests {
             .zip(noise)
             .map(|(n, e): (&f64, f64)| e * n.powi(-2))
             .collect();
-        let fit = fit_slope(&ns, &vars);
+        let fit = fit_slope(&ns, &vars).unwrap();
         let (lo, hi) = fit.slope_ci.unwrap();
-        assert!(lo < fit.slope && fit.slope < hi && hi - lo > 0.01);
-        assert!(lo < -2.0 && hi > -2.0);
+        // Reference: NumPy's lstsq and SciPy's t.ppf(0.975, 3) = 3.18245 on
+        // the same five points give slope −2.0098502 and half-width
+        // 0.0639771 (the table's t = 3.182 moves it by 1e-5).
+        assert!((fit.slope + 2.009_850_2).abs() < 1e-6, "{}", fit.slope);
+        assert!(((hi - lo) / 2.0 - 0.063_977).abs() < 5e-5, "{lo} {hi}");
+    }
+
+    #[test]
+    fn undefined_slopes_are_errors() {
+        for (ns, vars, phrase) in [
+            (&[16.0, 16.0][..], &[1e-3, 2e-3][..], "distinct N"),
+            (&[16.0, 64.0], &[1e-3, 0.0], "positive"),
+            (&[16.0, 64.0], &[1e-3, f64::NAN], "positive"),
+            (&[16.0, 64.0, 256.0], &[1e-3, 2e-3], "N values against"),
+        ] {
+            let e = fit_slope(ns, vars).unwrap_err().to_string();
+            assert!(e.contains(phrase), "{e}");
+        }
     }
 }

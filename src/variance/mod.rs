@@ -15,7 +15,7 @@ pub mod measure;
 pub mod radial;
 pub mod spatial;
 
-pub use convergence::{SlopeFit, fit_slope, theoretical_rate};
+pub use convergence::{SlopeError, SlopeFit, fit_slope, theoretical_rate};
 pub use empirical::{EmpiricalEstimate, empirical, empirical_shifting};
 pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_parts};
 pub use measure::{SamplerVariance, fourier_half, sampler_variance};
