@@ -2,10 +2,11 @@
 //! mutated inputs (tests/common/fuzz.rs), 1,000,000 per parser by default,
 //! in parallel chunks (input i comes from stream (seed, i): reproducible
 //! for any thread count). Prints a markdown table and writes `fuzz.csv` to
-//! the folder given.
+//! the folder given. The `fuzz` profile keeps overflow checks and debug
+//! assertions on (a wrapped integer is a panic there, as in `cargo test`).
 //!
 //! ```sh
-//! cargo run --release --example fuzz_parsers -- results/fuzz 1000000
+//! cargo run --profile fuzz --example fuzz_parsers -- results/fuzz 1000000
 //! ```
 
 #[path = "../tests/common/fuzz.rs"]

@@ -349,3 +349,22 @@ fn npy_point_sets_round_trip_and_read_what_numpy_writes() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn an_npy_shape_that_disagrees_with_its_data_is_refused() {
+    // Found by the fuzzer: a shape of 2^63 × 3 × 2 (its product wraps) over
+    // 48 bytes of data indexed past the data and panicked.
+    let mut header =
+        "{'descr': '<f8', 'fortran_order': False, 'shape': (9223372036854775808, 3, 2), }"
+            .to_string();
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    bytes.extend_from_slice(&[0u8; 48]);
+    let err = varspec::io::npy::read_point_sets_npy(&bytes[..]).unwrap_err();
+    assert!(err.contains("does not match"), "{err}");
+}

@@ -95,6 +95,15 @@ pub fn read_point_sets_npy(reader: impl Read) -> Result<Vec<PointSet>, String> {
         }
     };
     let (sets, n, d) = (sets as usize, n as usize, d as usize);
+    // The header's shape and the data must agree (a shape whose product
+    // overflows would otherwise index past the data).
+    let expected = sets.checked_mul(n).and_then(|c| c.checked_mul(d));
+    if expected != Some(values.len()) {
+        return Err(format!(
+            "the array's shape {shape:?} does not match its {} values",
+            values.len()
+        ));
+    }
     let at = |s: usize, i: usize, j: usize| {
         if fortran {
             s + sets * (i + n * j)

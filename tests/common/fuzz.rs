@@ -35,6 +35,11 @@ const TOKENS: &[&str] = &[
     "4294967296",
     "18446744073709551616",
     "99999999999999999999999",
+    "-9223372036854775808",
+    "9223372036854775807",
+    "18446744073709551615",
+    "-2147483648",
+    "4294967295",
     "1e6",
     "0x10",
     "1_000",
@@ -341,6 +346,15 @@ pub fn targets() -> Vec<Target> {
             run: Box::new(|b| {
                 varspec::scene::description::SceneFile::parse(&text(b), "fuzz.json").is_ok()
             }),
+        },
+        Target {
+            name: "scene pixel spec",
+            seeds: lines(&[
+                "scene:dof,px=33,py=1",
+                "scene:shadows-square,px=0,py=255",
+                "scene:scenes/dof.json,px=10,py=20",
+            ]),
+            run: Box::new(|b| varspec::scene::pixel::PixelIntegrand::parse_spec(&text(b)).is_ok()),
         },
         Target {
             name: "shard spec",
