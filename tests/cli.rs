@@ -846,3 +846,29 @@ fn a_radial_table_of_huge_weights_is_optimized_not_returned_as_its_start() {
     assert!(end < jitter, "optimized {end} against jitter {jitter}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_closed_standard_output_is_not_an_error() {
+    // `varspec … | head -1`: the reader leaves after the first line. print!
+    // panicked with "failed printing to stdout: Broken pipe" and a backtrace.
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args([
+            "converge",
+            "--sampler",
+            "jitter",
+            "--n",
+            "16,64,256,1024",
+            "--integrand",
+            "disk:r=0.3",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}: {err}", out.status);
+    assert!(!err.contains("panicked"), "{err}");
+}

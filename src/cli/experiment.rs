@@ -29,7 +29,7 @@ pub struct Args {
     file: PathBuf,
     /// Output folder (default out/experiments/<name>; results/ only when
     /// asked for, so tracked files are not overwritten by accident).
-    #[arg(short = 'o', long = "output")]
+    #[arg(short = 'o', long = "output", visible_alias = "out")]
     output: Option<PathBuf>,
     /// Run only shard i of n (0-based, e.g. 3/8 or $SLURM_ARRAY_TASK_ID/8)
     /// and write OUTPUT/shard-i-of-n.json; `varspec merge OUTPUT` combines them.
@@ -42,7 +42,7 @@ pub struct MergeArgs {
     /// Folder holding shard-i-of-n.json files of one experiment.
     folder: PathBuf,
     /// Where to write the merged tables (default: the same folder).
-    #[arg(short = 'o', long = "output")]
+    #[arg(short = 'o', long = "output", visible_alias = "out")]
     output: Option<PathBuf>,
 }
 

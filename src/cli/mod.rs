@@ -83,8 +83,50 @@ enum Command {
 /// Parses the arguments, runs the subcommand, reports any error on stderr.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    // `println!` panics when standard output was closed early (`varspec …
+    // | head`): that is not an error; say nothing and stop the command
+    // there, keeping what it wrote.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !is_stdout_closed(info.payload()) {
+            default_hook(info);
+        }
+    }));
     // A command's outputs appear together or not at all.
-    let result = varspec::io::all_or_nothing(|| match cli.command {
+    let result = varspec::io::all_or_nothing(|| {
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli.command))).unwrap_or_else(
+            |payload| {
+                if is_stdout_closed(payload.as_ref()) {
+                    Ok(())
+                } else {
+                    std::panic::resume_unwind(payload)
+                }
+            },
+        )
+    });
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// True for the panic of `print!` on a closed standard output.
+fn is_stdout_closed(payload: &(dyn std::any::Any + Send)) -> bool {
+    let text = payload
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| payload.downcast_ref::<&str>().copied())
+        .unwrap_or("");
+    text.starts_with("failed printing to stdout") && text.contains("Broken pipe")
+}
+
+/// Runs one subcommand.
+fn run(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Report(a) => report::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Plot(c) => plot::run(c),
@@ -110,14 +152,6 @@ pub fn main() -> ExitCode {
         Command::Render(a) => render::run(a),
         Command::Tables(a) => tables::run(a),
         Command::Integrands(a) => integrands::run(a),
-    });
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) if is_broken_pipe(&e) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::FAILURE
-        }
     }
 }
 

@@ -11,7 +11,7 @@ use serde_json::json;
 
 use super::{args, progress};
 use varspec::baseline::classic_baselines;
-use varspec::io::{PointFormat, write_atomic, write_point_sets};
+use varspec::io::write_atomic;
 use varspec::optimize::adapted::{
     CheckpointEvent, CheckpointPlan, Kept, checkpoint_path, design_sets, remove_checkpoints,
 };
@@ -99,7 +99,8 @@ pub struct PointsArgs {
     /// lattice by the exact variance, for 2D integrands with a closed-form
     /// autocovariance; cmj for other 2D integrand targets; random for other
     /// torus targets; umj for projection targets; jitter on the square).
-    #[arg(long)]
+    /// `--sampler` as in every other command.
+    #[arg(long, visible_alias = "sampler")]
     init: Option<String>,
     /// Square: family members the result and the classic samplers are scored on.
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
@@ -411,7 +412,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     let sets: Vec<_> = results.iter().map(|r| r.points.clone()).collect();
-    write_atomic(&a.output, |w| write_point_sets(w, &sets, PointFormat::Csv))?;
+    varspec::io::write_point_file(&a.output, &sets)?;
     if let Some(path) = &a.checkpoint {
         for (file, e) in remove_checkpoints(path, a.sets) {
             eprintln!("warning: checkpoint {} not removed: {e}", file.display());
@@ -590,7 +591,7 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     let sets: Vec<_> = results.iter().map(|r| r.1.points.clone()).collect();
-    write_atomic(&a.output, |w| write_point_sets(w, &sets, PointFormat::Csv))?;
+    varspec::io::write_point_file(&a.output, &sets)?;
     let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
     let mut per_term = Vec::new();
     println!(
@@ -672,7 +673,7 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     let sets: Vec<_> = results.iter().map(|r| r.points.clone()).collect();
-    write_atomic(&a.output, |w| write_point_sets(w, &sets, PointFormat::Csv))?;
+    varspec::io::write_point_file(&a.output, &sets)?;
     // Scores on members drawn with --score-seed.
     // The peer's two families, and the target's own.
     let mut families = vec![Family::parse("halfplanes")?, Family::parse("gaussians")?];
@@ -813,7 +814,7 @@ fn sheared_outputs(
         .collect::<Result<_, _>>()?;
     let sheared: Vec<_> = sets.iter().map(transform).collect::<Result<_, _>>()?;
     if let Some(path) = &a.output {
-        write_atomic(path, |w| write_point_sets(w, &sheared, PointFormat::Csv))?;
+        varspec::io::write_point_file(path, &sheared)?;
     }
     if let Some(prefix) = &a.png_prefix {
         projection_pngs(

@@ -25,8 +25,9 @@ pub struct Args {
     /// Any 4D sampler of the registry, with `name:key=value` parameters.
     #[arg(long, default_value = "umj")]
     sampler: String,
-    /// Samples per pixel (the sampler's N; umj needs a square).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 16)]
+    /// Samples per pixel (the sampler's N; umj needs a square). `-n`/`--n`
+    /// as in every other command.
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'n', long, visible_alias = "n", default_value_t = 16)]
     spp: usize,
     /// Shear of each pixel's set: none; analytic (the shear following the
     /// centre depth's light field); pilot (the best of none and every

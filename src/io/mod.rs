@@ -11,3 +11,25 @@ pub use atomic::{
 };
 pub use bounded::{read_bounded, read_text_bounded};
 pub use pointfile::{PointFileError, PointFormat, read_point_sets, write_point_sets};
+
+/// Writes point sets to `path` atomically, as NumPy `.npy` when its
+/// extension says so (any case), else as CSV: the rule of every command's
+/// `-o` (`sample --format` can also choose UTK text).
+///
+/// # Errors
+/// [`WriteError`] naming `path`.
+pub fn write_point_file(
+    path: &std::path::Path,
+    sets: &[crate::PointSet],
+) -> Result<(), WriteError> {
+    let npy = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+    write_atomic(path, |w| {
+        if npy {
+            npy::write_point_sets_npy(w, sets)
+        } else {
+            write_point_sets(w, sets, PointFormat::Csv)
+        }
+    })
+}

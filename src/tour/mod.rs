@@ -577,9 +577,12 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
                 Method::Fast { tolerance: 1e-9 },
                 sets.len(),
                 |r| {
-                    sets[r]
-                        .projected(&dims)
-                        .map_err(|e| crate::spectrum::SpectrumError::Pcf(e.to_string()))
+                    sets[r].projected(&dims).map_err(|e| {
+                        crate::spectrum::SpectrumError::Realization {
+                            index: r,
+                            message: format!("projection onto {dims:?}: {e}"),
+                        }
+                    })
                 },
                 &|| {},
             )
