@@ -104,16 +104,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
          sqrt(2/(sqrt(3) N)) (Lagae & Dutre 2008; 1 = densest packing, random ~ 0.01 / 0.5)."
     );
     let csv = a.output.join("summary.csv");
+    #[derive(serde::Serialize)]
+    struct Summary<'a> {
+        sampler: &'a str,
+        n: usize,
+        sets: usize,
+        mpoints_per_s: f64,
+        nn_min_rel: f64,
+        nn_mean_rel: f64,
+    }
     write_atomic(&csv, |w| {
-        writeln!(w, "sampler,n,sets,mpoints_per_s,nn_min_rel,nn_mean_rel")?;
-        for r in &rows {
-            writeln!(
-                w,
-                "{},{},{},{},{},{}",
-                r.name, r.n, a.sets, r.mpts_per_s, r.min_rel, r.mean_rel
-            )?;
-        }
-        Ok(())
+        varspec::io::write_csv_rows(
+            w,
+            rows.iter().map(|r| Summary {
+                sampler: r.name,
+                n: r.n,
+                sets: a.sets,
+                mpoints_per_s: r.mpts_per_s,
+                nn_min_rel: r.min_rel,
+                nn_mean_rel: r.mean_rel,
+            }),
+        )
     })?;
     println!(
         "wrote {} and one PNG per sampler in {}",

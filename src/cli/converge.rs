@@ -194,17 +194,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map(|p| format!("{} -> {}", p.requested, p.n))
         .collect();
     if let Some(path) = &a.csv {
+        #[derive(serde::Serialize)]
+        struct Row {
+            n: usize,
+            variance: f64,
+            stderr: Option<f64>,
+            truncation_bound: f64,
+        }
         write_atomic(path, |w| {
-            writeln!(w, "n,variance,stderr,truncation_bound")?;
-            for p in &points {
-                let stderr = p.stderr.map_or(String::new(), |s| format!("{s:?}"));
-                writeln!(
-                    w,
-                    "{},{:?},{stderr},{:?}",
-                    p.n, p.variance, p.truncation_bound
-                )?;
-            }
-            Ok(())
+            varspec::io::write_csv_rows(
+                w,
+                points.iter().map(|p| Row {
+                    n: p.n,
+                    variance: p.variance,
+                    stderr: p.stderr,
+                    truncation_bound: p.truncation_bound,
+                }),
+            )
         })?;
     }
     if let Some(path) = &a.png {

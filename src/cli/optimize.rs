@@ -499,13 +499,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         .zip(results[0].descent.losses.iter().copied())
         .collect();
     if let Some(path) = &a.curve {
-        write_atomic(path, |w| {
-            writeln!(w, "iteration,seconds,loss")?;
-            for (i, (t, l)) in curve.iter().enumerate() {
-                writeln!(w, "{i},{t:?},{l:?}")?;
-            }
-            Ok(())
-        })?;
+        write_loss_curve(path, curve.iter().map(|&(t, l)| (t, l)))?;
     }
     if let Some(path) = &a.curve_png {
         use varspec::report::plot::{LinePlot, Series, line_plot_png};
@@ -731,18 +725,14 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
         );
     }
     if let Some(path) = &a.curve {
-        write_atomic(path, |w| {
-            writeln!(w, "iteration,seconds,loss")?;
-            for (i, (t, l)) in results[0]
+        write_loss_curve(
+            path,
+            results[0]
                 .seconds
                 .iter()
-                .zip(&results[0].losses)
-                .enumerate()
-            {
-                writeln!(w, "{i},{t:?},{l:?}")?;
-            }
-            Ok(())
-        })?;
+                .copied()
+                .zip(results[0].losses.iter().copied()),
+        )?;
     }
     if let Some(path) = &a.report {
         let report = json!({
@@ -1083,5 +1073,29 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             );
         }
     }
+    Ok(())
+}
+
+/// The loss curve CSV (`--curve`): iteration, wall seconds, loss.
+fn write_loss_curve(
+    path: &std::path::Path,
+    curve: impl Iterator<Item = (f64, f64)>,
+) -> anyhow::Result<()> {
+    #[derive(serde::Serialize)]
+    struct Row {
+        iteration: usize,
+        seconds: f64,
+        loss: f64,
+    }
+    write_atomic(path, |w| {
+        varspec::io::write_csv_rows(
+            w,
+            curve.enumerate().map(|(iteration, (seconds, loss))| Row {
+                iteration,
+                seconds,
+                loss,
+            }),
+        )
+    })?;
     Ok(())
 }

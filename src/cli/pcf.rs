@@ -6,7 +6,7 @@ use anyhow::bail;
 
 use super::progress;
 use super::source::SourceArgs;
-use varspec::io::write_atomic;
+use varspec::io::{write_atomic, write_csv_rows};
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
 use varspec::samplers::packing_radius;
 use varspec::spectrum::pcf::pair_correlation;
@@ -85,12 +85,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     let pcf = pair_correlation(&sets, a.range * unit, a.bins, a.bandwidth * unit)?;
+    #[derive(serde::Serialize)]
+    struct Row {
+        r: f64,
+        r_rel: f64,
+        g: f64,
+    }
     let write = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
-        writeln!(w, "r,r_rel,g")?;
-        for (r, g) in pcf.r.iter().zip(&pcf.g) {
-            writeln!(w, "{r:?},{:?},{g:?}", r / unit)?;
-        }
-        Ok(())
+        write_csv_rows(
+            w,
+            pcf.r.iter().zip(&pcf.g).map(|(&r, &g)| Row {
+                r,
+                r_rel: r / unit,
+                g,
+            }),
+        )
     };
     match &a.csv {
         Some(path) => write_atomic(path, write)?,

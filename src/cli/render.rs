@@ -207,22 +207,34 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     if let Some(path) = &a.analysis {
+        #[derive(serde::Serialize)]
+        struct Row<'a> {
+            px: usize,
+            py: usize,
+            kind: &'a str,
+            depth: f64,
+            kappa: f64,
+            shear_form: &'a str,
+            a: f64,
+            b: f64,
+        }
         write_atomic(path, |out| {
-            writeln!(out, "px,py,kind,depth,kappa,shear_form,a,b")?;
-            for (i, (p, s)) in analysis.iter().zip(&shears).enumerate() {
-                let [sa, sb] = s.amounts();
-                writeln!(
-                    out,
-                    "{},{},{},{:?},{:?},{},{sa:?},{sb:?}",
-                    i % w,
-                    i / w,
-                    p.kind.name(),
-                    p.depth,
-                    p.kappa,
-                    s.form()
-                )?;
-            }
-            Ok(())
+            varspec::io::write_csv_rows(
+                out,
+                analysis.iter().zip(&shears).enumerate().map(|(i, (p, s))| {
+                    let [a, b] = s.amounts();
+                    Row {
+                        px: i % w,
+                        py: i / w,
+                        kind: p.kind.name(),
+                        depth: p.depth,
+                        kappa: p.kappa,
+                        shear_form: s.form(),
+                        a,
+                        b,
+                    }
+                }),
+            )
         })?;
     }
     if let Some(path) = &a.shear_png {

@@ -9,7 +9,7 @@ use super::progress;
 use super::source::SourceArgs;
 use varspec::integrands::Integrand;
 use varspec::io::npy::write_npy;
-use varspec::io::write_atomic;
+use varspec::io::{write_atomic, write_csv_rows};
 use varspec::report::plot::{LinePlot, Series, line_plot_png, power_png};
 use varspec::scene::pixel::PixelIntegrand;
 use varspec::spectrum::expected::check_memory;
@@ -152,22 +152,42 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     };
     let profile = radial_profile(&spectrum);
+    #[derive(serde::Serialize)]
+    struct RadialRow {
+        k: usize,
+        power: f64,
+        anisotropy: f64,
+    }
     let radial_csv = |w: &mut dyn std::io::Write| -> std::io::Result<()> {
-        writeln!(w, "k,power,anisotropy")?;
-        for b in &profile {
-            writeln!(w, "{},{:?},{:?}", b.k, b.power, b.anisotropy)?;
-        }
-        Ok(())
+        write_csv_rows(
+            w,
+            profile.iter().map(|b| RadialRow {
+                k: b.k,
+                power: b.power,
+                anisotropy: b.anisotropy,
+            }),
+        )
     };
     if let Some(path) = &a.csv {
+        #[derive(serde::Serialize)]
+        struct PowerRow {
+            kx: i64,
+            ky: i64,
+            power: f64,
+        }
         write_atomic(path, |w| {
-            writeln!(w, "kx,ky,power")?;
             let mut k = [0i64; 2];
-            for (idx, p) in spectrum.power.iter().enumerate() {
-                freqs.frequency(idx, &mut k);
-                writeln!(w, "{},{},{:?}", k[0], k[1], p)?;
-            }
-            Ok(())
+            write_csv_rows(
+                w,
+                spectrum.power.iter().enumerate().map(|(idx, &power)| {
+                    freqs.frequency(idx, &mut k);
+                    PowerRow {
+                        kx: k[0],
+                        ky: k[1],
+                        power,
+                    }
+                }),
+            )
         })?;
     }
     if let Some(path) = &a.npy {

@@ -2,6 +2,7 @@
 
 pub mod atomic;
 pub mod bounded;
+pub mod csv_rows;
 pub mod npy;
 pub mod pointfile;
 pub mod tables;
@@ -10,6 +11,7 @@ pub use atomic::{
     WriteError, all_or_nothing, check_output, read_output, write_atomic, write_atomic_now,
 };
 pub use bounded::{read_bounded, read_text_bounded};
+pub use csv_rows::write_csv_rows;
 pub use pointfile::{PointFileError, PointFormat, read_point_sets, write_point_sets};
 
 /// Writes point sets to `path` atomically, as NumPy `.npy` when its
