@@ -51,13 +51,27 @@ fn fourier_predictions_match_the_exact_expected_variances() {
         let realization =
             |r: usize| -> Result<_, VarianceError> { Ok(s.sample(&mut set_rng(77, r as u64))?) };
         let e = fourier(f.as_ref(), 63, 1e-10, 400, realization).unwrap();
-        let allowed = Z * e.stderr + e.truncation_bound + 2e-6 * exact;
+        // The predictor completes the box |k|∞ ≤ 63 with the white tail
+        // T/N, T = c_f(0) − Σ_(box) P_f (Parseval, computed here from the
+        // closed forms). For random N·E[P_S(k)] = 1 and for jitter it lies
+        // in [0, 1] at every k ≠ 0 (tests/data/README.md), so that tail
+        // errs by at most T/N: a bound that holds for these samplers, not
+        // the predictor's own estimate.
+        let mut in_box = 0.0;
+        for kx in -63i64..=63 {
+            for ky in -63i64..=63 {
+                if (kx, ky) != (0, 0) {
+                    in_box += f.fourier(&[kx, ky]).norm_sqr();
+                }
+            }
+        }
+        let tail = (f.variance() - in_box).max(0.0) / n as f64;
+        let allowed = Z * e.stderr + tail + 2e-6 * exact;
         assert!(
             (e.variance - exact).abs() <= allowed,
-            "{spec} {sampler} N={n}: fourier {:e} ± {:e} (bound {:e}) vs exact {exact:e}",
+            "{spec} {sampler} N={n}: fourier {:e} ± {:e} (tail bound {tail:e}) vs exact {exact:e}",
             e.variance,
             e.stderr,
-            e.truncation_bound
         );
     }
 }
