@@ -16,7 +16,9 @@ use varspec::report::plot::{LinePlot, Series, line_plot_png};
 use varspec::rng::set_rng;
 use varspec::samplers;
 use varspec::square::{Family, family_mse};
-use varspec::variance::{VarianceError, fit_slope, fourier, spatial, theoretical_rate};
+use varspec::variance::{
+    VarianceError, VarianceForm, fit_slope, sampler_variance, theoretical_rate,
+};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum MethodArg {
@@ -142,20 +144,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 let e = family_mse(&sets, family, a.members, a.draw.seed());
                 (e.mse, e.stderr, 0.0)
             }
-            (Subject::Torus(f), MethodArg::Spatial) => {
-                let e = spatial(f.as_ref(), a.draw.sets(), realization)?;
-                (e.variance, e.stderr, 0.0)
-            }
-            (Subject::Torus(f), MethodArg::Fourier) => {
-                let e = fourier(
-                    f.as_ref(),
-                    a.res.map_or(varspec::variance::fourier_half(dim), |r| {
-                        r.saturating_sub(1) / 2
-                    }),
-                    1e-10,
-                    a.draw.sets(),
-                    realization,
-                )?;
+            (Subject::Torus(f), method) => {
+                let form = match method {
+                    MethodArg::Spatial => VarianceForm::Spatial,
+                    MethodArg::Fourier => VarianceForm::Fourier {
+                        half: a.res.map_or(varspec::variance::fourier_half(dim), |r| {
+                            r.saturating_sub(1) / 2
+                        }),
+                    },
+                };
+                let e = sampler_variance(f.as_ref(), a.draw.sets(), form, realization)?;
                 (e.variance, e.stderr, e.truncation_bound)
             }
         };

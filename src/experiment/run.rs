@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use super::spec::{Experiment, ExperimentError};
 use crate::integrands;
 use crate::samplers;
-use crate::variance::{VarianceError, sampler_variance};
+use crate::variance::{VarianceError, VarianceForm, sampler_variance};
 
 /// One (sampler, integrand, N) result.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -121,7 +121,7 @@ pub fn run_items(
         let sets = samplers::generate_sets(s.as_ref(), e.seed, e.sets, &|| {})
             .map_err(|err| fail("-", err.to_string()))?;
         for (fi, f) in functions.iter().enumerate() {
-            let p = sampler_variance(f.as_ref(), e.sets, |r| {
+            let p = sampler_variance(f.as_ref(), e.sets, VarianceForm::Auto, |r| {
                 Ok::<_, VarianceError>(sets[r].clone())
             })
             .map_err(|err| fail(&f.spec(), err.to_string()))?;

@@ -6,7 +6,7 @@
 use crate::integrands::IntegrandClass;
 
 /// A fitted power law Var ≈ a·N^slope.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SlopeFit {
     /// The slope of log Var on log N.
     pub slope: f64,

@@ -9,8 +9,24 @@ use super::{VarianceError, fourier, spatial};
 use crate::integrands::Integrand;
 use crate::points::PointSet;
 
+/// Which form of the variance to use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VarianceForm {
+    /// The spatial form where the integrand has a closed-form
+    /// autocovariance, else the Fourier form on [`fourier_half`]'s box.
+    Auto,
+    /// The exact spatial form (refused without a closed-form
+    /// autocovariance).
+    Spatial,
+    /// The Fourier form on the box |k|∞ ≤ `half`.
+    Fourier {
+        /// Box half-width.
+        half: usize,
+    },
+}
+
 /// A sampler-level variance.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SamplerVariance {
     /// Mean over realizations.
     pub variance: f64,
@@ -33,19 +49,33 @@ pub fn fourier_half(dim: usize) -> usize {
 }
 
 /// The variance of the shift-randomized estimator averaged over `sets`
-/// realizations.
+/// realizations, by the form `form` says (`converge --method`; `Auto` for
+/// `experiment`).
 ///
 /// # Errors
 /// As [`spatial`] and [`fourier`].
 pub fn sampler_variance<E>(
     f: &dyn Integrand,
     sets: usize,
+    form: VarianceForm,
     realization: impl Fn(usize) -> Result<PointSet, E> + Sync,
 ) -> Result<SamplerVariance, VarianceError>
 where
     VarianceError: From<E>,
     E: Send,
 {
+    let by_fourier = |half: usize| -> Result<SamplerVariance, VarianceError> {
+        let p = fourier(f, half, 1e-10, sets, &realization)?;
+        Ok(SamplerVariance {
+            variance: p.variance,
+            stderr: p.stderr,
+            truncation_bound: p.truncation_bound,
+            method: "fourier",
+        })
+    };
+    if let VarianceForm::Fourier { half } = form {
+        return by_fourier(half);
+    }
     match spatial(f, sets, &realization) {
         Ok(p) => Ok(SamplerVariance {
             variance: p.variance,
@@ -53,14 +83,8 @@ where
             truncation_bound: 0.0,
             method: "spatial",
         }),
-        Err(VarianceError::NoAutocovariance { .. }) => {
-            let p = fourier(f, fourier_half(f.dim()), 1e-10, sets, realization)?;
-            Ok(SamplerVariance {
-                variance: p.variance,
-                stderr: p.stderr,
-                truncation_bound: p.truncation_bound,
-                method: "fourier",
-            })
+        Err(VarianceError::NoAutocovariance { .. }) if form == VarianceForm::Auto => {
+            by_fourier(fourier_half(f.dim()))
         }
         Err(e) => Err(e),
     }
