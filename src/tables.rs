@@ -3,6 +3,8 @@
 //! they were designed for, and their predicted variance on reference
 //! integrands. The formats themselves are written by [`crate::io::tables`].
 
+pub mod shard;
+
 use crate::integrands;
 use crate::io::tables::{TableFormat, TableMetadata};
 use crate::points::PointSet;

@@ -366,5 +366,23 @@ fn an_npy_shape_that_disagrees_with_its_data_is_refused() {
     bytes.extend_from_slice(header.as_bytes());
     bytes.extend_from_slice(&[0u8; 48]);
     let err = varspec::io::npy::read_point_sets_npy(&bytes[..]).unwrap_err();
-    assert!(err.contains("does not match"), "{err}");
+    assert!(err.contains("holds more values"), "{err}");
+    // A shape whose product overflows 64 bits (the reader multiplied it out
+    // and panicked where overflow is checked).
+    for shape in [
+        "(9223372036854775807, 3, 2)",
+        "(18446744073709551615, 3, 2)",
+    ] {
+        let mut header = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': {shape}, }}");
+        while (10 + header.len() + 1) % 64 != 0 {
+            header.push(' ');
+        }
+        header.push('\n');
+        let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+        bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+        bytes.extend_from_slice(header.as_bytes());
+        bytes.extend_from_slice(&[0u8; 48]);
+        let err = varspec::io::npy::read_point_sets_npy(&bytes[..]).unwrap_err();
+        assert!(err.contains("holds more values"), "{shape}: {err}");
+    }
 }

@@ -316,3 +316,67 @@ fn f32_at_or_below(x: f64) -> f32 {
         f
     }
 }
+
+#[test]
+fn a_sharded_table_run_merges_to_the_single_runs_bytes() {
+    let dir = std::env::temp_dir().join(format!("varspec-table-shards-{}", std::process::id()));
+    let (whole, parts) = (dir.join("whole"), dir.join("parts"));
+    std::fs::create_dir_all(&whole).unwrap();
+    std::fs::create_dir_all(&parts).unwrap();
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let draw = [
+        "tables",
+        "--sampler",
+        "cmj",
+        "-n",
+        "64",
+        "--sets",
+        "10",
+        "--seed",
+        "3",
+    ];
+    let table = |d: &std::path::Path| d.join("t.h").to_str().unwrap().to_owned();
+    run(&[&draw[..], &["--format", "c-header", "-o", &table(&whole)]].concat());
+    // Shards in reverse order: the merge must not depend on it.
+    for i in (0..3).rev() {
+        let shard = format!("{i}/3");
+        run(&[&draw[..], &["--shard", &shard, "-o", &table(&parts)]].concat());
+    }
+    run(&[
+        "tables",
+        "--merge",
+        "--format",
+        "c-header",
+        "-o",
+        &table(&parts),
+    ]);
+    assert_eq!(
+        std::fs::read(whole.join("t.h")).unwrap(),
+        std::fs::read(parts.join("t.h")).unwrap(),
+        "the merged table differs from the single run's"
+    );
+    std::fs::remove_file(parts.join("t.h.shard-1-of-3.json")).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args([
+            "tables",
+            "--merge",
+            "--format",
+            "c-header",
+            "-o",
+            &table(&parts),
+        ])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("shard 1/3 is missing"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -37,7 +37,7 @@ pub struct DrawArgs {
     sets_given: Option<usize>,
     /// Seed (default 0): the same seed gives bit-identical realizations
     /// for any thread count.
-    #[arg(value_parser = whole::<u64>, allow_negative_numbers = true, long = "seed")]
+    #[arg(value_parser = whole::<u64>, allow_negative_numbers = true, long = "seed", value_name = "SEED")]
     seed_given: Option<u64>,
     /// Sampler parameter key=value (repeatable; see `varspec sample --list`).
     #[arg(long = "param", value_parser = key_value)]

@@ -7,11 +7,13 @@ use clap::ValueEnum;
 
 use super::args::DrawArgs;
 use super::progress;
+use varspec::experiment::Shard;
 use varspec::io::read_point_sets;
 use varspec::io::tables::{TableFormat, write_table};
 use varspec::io::write_atomic;
 use varspec::registry;
 use varspec::samplers;
+use varspec::tables::shard::{TableRun, TableShard, draw_shard, merge_table_shards};
 use varspec::tables::{
     PredictedVariances, Provenance, REFERENCE_INTEGRANDS, metadata, optimized_for,
 };
@@ -28,7 +30,7 @@ enum FormatArg {
 #[derive(clap::Args)]
 pub struct Args {
     /// Sampler to draw the table from.
-    #[arg(long, conflicts_with = "from", required_unless_present = "from")]
+    #[arg(long, conflicts_with = "from", required_unless_present_any = ["from", "merge"])]
     sampler: Option<String>,
     /// Point-set file to convert instead.
     #[arg(long)]
@@ -42,11 +44,20 @@ pub struct Args {
     #[command(flatten)]
     draw: DrawArgs,
     /// Output format.
-    #[arg(long, value_enum)]
-    format: FormatArg,
+    #[arg(long, value_enum, required_unless_present = "shard")]
+    format: Option<FormatArg>,
     /// Output file (csv, f32 and f64 also get PATH.json with the metadata).
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
+    /// Draw only shard i of n of the sets (set r when r mod n = i) into
+    /// OUTPUT.shard-i-of-n.json; `--merge` then writes the table, byte for
+    /// byte the one a single run writes (with --sampler; Slurm's array
+    /// index as i).
+    #[arg(long, requires = "sampler", value_parser = varspec::experiment::Shard::parse)]
+    shard: Option<varspec::experiment::Shard>,
+    /// Write the table from every OUTPUT.shard-i-of-n.json beside OUTPUT.
+    #[arg(long, conflicts_with_all = ["sampler", "from", "n", "dim", "sets_given", "params", "seed_given"])]
+    merge: bool,
     /// Compute the metadata's predicted variances whatever the cost (the
     /// exact spatial form is O(N²) per set; by default they are skipped,
     /// with a note, beyond 2^28 pair evaluations).
@@ -56,7 +67,22 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs([Some(a.output.as_path())])?;
+    if let Some(shard) = a.shard {
+        return draw_table_shard(&a, shard);
+    }
+    let mut run_params = a.draw.params.clone();
+    let mut run_seed = a.draw.seed();
+    let mut run_sampler = a.sampler.clone();
     let (sets, source) = match (&a.sampler, &a.from) {
+        _ if a.merge => {
+            let shards = read_table_shards(&a.output)?;
+            let (run, sets) = merge_table_shards(&shards)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", a.output.display()))?;
+            run_params = run.params;
+            run_seed = run.seed;
+            run_sampler = Some(run.sampler.clone());
+            (sets, run.sampler)
+        }
         (Some(name), _) => {
             let n = a.n.context("--sampler needs -n")?;
             if a.draw.sets() == 0 {
@@ -81,7 +107,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         (None, None) => bail!("give --sampler or --from"),
     };
-    let format = match a.format {
+    let format = match a.format.context("--format is needed to write a table")? {
         FormatArg::Csv => TableFormat::Csv,
         FormatArg::Json => TableFormat::Json,
         FormatArg::F32 => TableFormat::F32,
@@ -89,10 +115,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         FormatArg::CHeader => TableFormat::CHeader,
     };
     let provenance = Provenance {
-        optimized_for: optimized_for(a.sampler.as_deref(), &a.draw.params)?,
+        optimized_for: optimized_for(run_sampler.as_deref(), &run_params)?,
         source,
-        params: a.draw.params.clone(),
-        seed: a.draw.seed(),
+        params: run_params,
+        seed: run_seed,
     };
     let (meta, predicted) = metadata(&sets, provenance, format, a.variance)?;
     if let PredictedVariances::OverBudget { pairs } = predicted {
@@ -128,4 +154,79 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         meta.dim
     );
     Ok(())
+}
+
+/// The shard file of `output` for shard i of n.
+fn shard_path(output: &std::path::Path, shard: Shard) -> PathBuf {
+    let mut name = output.as_os_str().to_owned();
+    name.push(format!(".shard-{}-of-{}.json", shard.index, shard.count));
+    PathBuf::from(name)
+}
+
+/// `tables --shard i/n`: draws the shard's sets and writes them with the run.
+fn draw_table_shard(a: &Args, shard: Shard) -> anyhow::Result<()> {
+    let name = a.sampler.as_deref().context("--shard needs --sampler")?;
+    let n = a.n.context("--sampler needs -n")?;
+    if a.draw.sets() == 0 {
+        bail!("--sets must be at least 1");
+    }
+    let sampler = registry::build(name, n, a.dim, &a.draw.params)?;
+    let run = TableRun {
+        sampler: name.to_string(),
+        n,
+        dim: a.dim,
+        params: a.draw.params.clone(),
+        seed: a.draw.seed(),
+        sets: a.draw.sets(),
+    };
+    let mine = (shard.index..run.sets).step_by(shard.count).count();
+    let bar = progress::bar(mine as u64, "sampling");
+    let part = draw_shard(sampler.as_ref(), run, shard, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let path = shard_path(&a.output, shard);
+    let json = serde_json::to_string(&part)?;
+    write_atomic(&path, |w| w.write_all(json.as_bytes()))?;
+    println!(
+        "wrote {} ({mine} of {} sets)",
+        path.display(),
+        part.run.sets
+    );
+    Ok(())
+}
+
+/// Every OUTPUT.shard-i-of-n.json beside `output`.
+fn read_table_shards(output: &std::path::Path) -> anyhow::Result<Vec<TableShard>> {
+    let folder = match output.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    let file = output
+        .file_name()
+        .context("--merge needs -o naming the table file")?;
+    let prefix = format!("{}.shard-", file.to_string_lossy());
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(folder)
+        .with_context(|| format!("cannot read folder {}", folder.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with(&prefix) && n.ends_with(".json"))
+        })
+        .collect();
+    paths.sort();
+    if paths.is_empty() {
+        bail!(
+            "no {prefix}i-of-n.json files in {} to merge (write them with --shard i/n)",
+            folder.display()
+        );
+    }
+    paths
+        .iter()
+        .map(|p| {
+            let text = varspec::io::read_text_bounded(p, 1 << 34, "a table shard")
+                .with_context(|| format!("cannot read {}", p.display()))?;
+            serde_json::from_str(&text)
+                .with_context(|| format!("{}: not a table shard", p.display()))
+        })
+        .collect()
 }

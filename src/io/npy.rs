@@ -60,8 +60,10 @@ pub const MAGIC: &[u8] = b"\x93NUMPY";
 /// # Errors
 /// A sentence saying what is wrong: header, dtype, shape, a value (with its
 /// index) or a short read.
-pub fn read_point_sets_npy(reader: impl Read) -> Result<Vec<PointSet>, String> {
-    let file = NpyFile::new(reader).map_err(|e| format!("not a readable .npy array: {e}"))?;
+pub fn read_point_sets_npy(mut reader: impl Read) -> Result<Vec<PointSet>, String> {
+    let header = read_header_checked(&mut reader)?;
+    let file = NpyFile::new(io::Cursor::new(header).chain(reader))
+        .map_err(|e| format!("not a readable .npy array: {e}"))?;
     let shape = file.shape().to_vec();
     let (sets, n, d) = match shape[..] {
         [n, d] => (1, n, d),
@@ -128,6 +130,59 @@ pub fn read_point_sets_npy(reader: impl Read) -> Result<Vec<PointSet>, String> {
             PointSet::new(d, coords).map_err(|e| e.to_string())
         })
         .collect()
+}
+
+/// Reads the magic, version, length and header text (returned as bytes,
+/// to be read again by npyz) and refuses a `shape` whose product of
+/// dimensions does not fit 64 bits: npyz multiplies it out and would
+/// overflow (a panic where overflow is checked).
+fn read_header_checked(reader: &mut impl Read) -> Result<Vec<u8>, String> {
+    let short = |e: io::Error| format!("not a readable .npy array: {e}");
+    let mut bytes = vec![0u8; 8];
+    reader.read_exact(&mut bytes).map_err(short)?;
+    if !bytes.starts_with(MAGIC) {
+        return Err("not a readable .npy array: no NumPy magic string".into());
+    }
+    let len_bytes = if bytes[6] == 1 { 2 } else { 4 };
+    let mut len = vec![0u8; len_bytes];
+    reader.read_exact(&mut len).map_err(short)?;
+    let header_len = len.iter().rev().fold(0usize, |a, &b| (a << 8) | b as usize);
+    if header_len > 1 << 20 {
+        return Err(format!(
+            "not a readable .npy array: a header of {header_len} bytes"
+        ));
+    }
+    bytes.extend_from_slice(&len);
+    let start = bytes.len();
+    bytes.resize(start + header_len, 0);
+    reader.read_exact(&mut bytes[start..]).map_err(short)?;
+    let text = String::from_utf8_lossy(&bytes[start..]);
+    if let Some(dims) = text
+        .split_once("'shape'")
+        .and_then(|(_, rest)| rest.split_once('('))
+        .and_then(|(_, rest)| rest.split_once(')'))
+        .map(|(dims, _)| dims)
+    {
+        // Each dimension's magnitude, whatever signs a Python literal puts
+        // before it (npyz reads `--5` as 5); a digit run beyond u64 counts
+        // as overflowing.
+        let magnitudes: Vec<Option<u64>> = dims
+            .split(',')
+            .map(|d| d.trim().trim_start_matches(['-', '+']))
+            .filter(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()))
+            .map(|d| d.parse::<u64>().ok())
+            .collect();
+        let product = magnitudes
+            .iter()
+            .try_fold(1u64, |a, d| d.and_then(|d| a.checked_mul(d)));
+        if product.is_none() {
+            return Err(format!(
+                "the array's shape ({}) holds more values than 2^64: not a point-set array",
+                dims.trim()
+            ));
+        }
+    }
+    Ok(bytes)
 }
 
 /// Every element of a reader, or the read error (a truncated file).

@@ -1,0 +1,118 @@
+//! Large table runs split over machines: a shard draws a deterministic
+//! 1/n of the sets (set r goes to shard r mod n, as an experiment's items)
+//! and keeps them with the run's configuration; merging every shard gives
+//! back the sets in order, so the table written from them is byte for byte
+//! the one a single run writes (set r is always drawn from stream
+//! (seed, r)).
+
+use serde::{Deserialize, Serialize};
+
+use crate::experiment::Shard;
+use crate::points::PointSet;
+use crate::rng::set_rng;
+use crate::samplers::{Sampler, SamplerError};
+
+/// What a table run draws: the same in every shard of one run.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct TableRun {
+    /// Sampler spec as given.
+    pub sampler: String,
+    /// Points per set as given.
+    pub n: usize,
+    /// Dimension as given.
+    pub dim: Option<usize>,
+    /// Sampler parameters.
+    pub params: Vec<(String, String)>,
+    /// Seed.
+    pub seed: u64,
+    /// Sets in the whole table.
+    pub sets: usize,
+}
+
+/// One shard's sets.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TableShard {
+    /// The run it belongs to.
+    pub run: TableRun,
+    /// Which part.
+    pub shard: Shard,
+    /// Dimension of the sets.
+    pub dim: usize,
+    /// (set index, coordinates) of the sets r ≡ i (mod n), in order.
+    pub sets: Vec<(usize, Vec<f64>)>,
+}
+
+/// Draws shard `shard` of `run` from `sampler` (built from the run's spec).
+///
+/// # Errors
+/// The sampler's error.
+pub fn draw_shard(
+    sampler: &dyn Sampler,
+    run: TableRun,
+    shard: Shard,
+    on_set: &(dyn Fn() + Sync),
+) -> Result<TableShard, SamplerError> {
+    use rayon::prelude::*;
+    let sets = (shard.index..run.sets)
+        .step_by(shard.count)
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .map(|r| {
+            let set = sampler.sample(&mut set_rng(run.seed, r as u64))?;
+            on_set();
+            Ok((r, set.coords().to_vec()))
+        })
+        .collect::<Result<Vec<_>, SamplerError>>()?;
+    Ok(TableShard {
+        run,
+        shard,
+        dim: sampler.dim(),
+        sets,
+    })
+}
+
+/// The run and its sets in order from every shard of one split.
+///
+/// # Errors
+/// A sentence naming what is wrong: no shards, shards of different runs or
+/// splits, a shard twice or missing, a set that is not a point set.
+pub fn merge_table_shards(shards: &[TableShard]) -> Result<(TableRun, Vec<PointSet>), String> {
+    let first = shards.first().ok_or("no table shards to merge")?;
+    let count = first.shard.count;
+    let mut seen = vec![false; count];
+    for s in shards {
+        if s.run != first.run || s.shard.count != count || s.dim != first.dim {
+            return Err(format!(
+                "shard {}/{} belongs to another table run or split than shard {}/{}",
+                s.shard.index, s.shard.count, first.shard.index, count
+            ));
+        }
+        if std::mem::replace(&mut seen[s.shard.index], true) {
+            return Err(format!("shard {}/{count} is given twice", s.shard.index));
+        }
+    }
+    if let Some(missing) = seen.iter().position(|&s| !s) {
+        return Err(format!("shard {missing}/{count} is missing"));
+    }
+    let mut sets: Vec<Option<PointSet>> = vec![None; first.run.sets];
+    for s in shards {
+        for (r, coords) in &s.sets {
+            let slot = sets
+                .get_mut(*r)
+                .filter(|_| r % count == s.shard.index)
+                .ok_or_else(|| {
+                    format!("shard {}/{count} holds set {r}, not its own", s.shard.index)
+                })?;
+            *slot = Some(
+                PointSet::new(first.dim, coords.clone())
+                    .map_err(|e| format!("set {r} of shard {}/{count}: {e}", s.shard.index))?,
+            );
+        }
+    }
+    let sets = sets
+        .into_iter()
+        .enumerate()
+        .map(|(r, s)| s.ok_or_else(|| format!("set {r} is in no shard")))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((first.run.clone(), sets))
+}
