@@ -323,11 +323,14 @@ fn a_sharded_table_run_merges_to_the_single_runs_bytes() {
     let (whole, parts) = (dir.join("whole"), dir.join("parts"));
     std::fs::create_dir_all(&whole).unwrap();
     std::fs::create_dir_all(&parts).unwrap();
-    let run = |args: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
+    let varspec = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_varspec"))
             .args(args)
             .output()
-            .unwrap();
+            .unwrap()
+    };
+    let run = |args: &[&str]| {
+        let out = varspec(args);
         assert!(
             out.status.success(),
             "{args:?}: {}",
@@ -352,31 +355,22 @@ fn a_sharded_table_run_merges_to_the_single_runs_bytes() {
         let shard = format!("{i}/3");
         run(&[&draw[..], &["--shard", &shard, "-o", &table(&parts)]].concat());
     }
-    run(&[
+    let merge = [
         "tables",
         "--merge",
         "--format",
         "c-header",
         "-o",
         &table(&parts),
-    ]);
+    ];
+    run(&merge);
     assert_eq!(
         std::fs::read(whole.join("t.h")).unwrap(),
         std::fs::read(parts.join("t.h")).unwrap(),
         "the merged table differs from the single run's"
     );
     std::fs::remove_file(parts.join("t.h.shard-1-of-3.json")).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
-        .args([
-            "tables",
-            "--merge",
-            "--format",
-            "c-header",
-            "-o",
-            &table(&parts),
-        ])
-        .output()
-        .unwrap();
+    let out = varspec(&merge);
     assert!(String::from_utf8_lossy(&out.stderr).contains("shard 1/3 is missing"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
