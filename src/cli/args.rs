@@ -99,33 +99,42 @@ pub fn check_outputs<'a>(
     Ok(())
 }
 
+/// Why a text is not a whole number.
+enum NotWhole {
+    Negative,
+    Fraction,
+    TooLarge,
+    Text,
+}
+
+/// A whole number ≥ 0 written plainly (16) or in scientific notation when
+/// that is whole (1e3): what [`whole`] and [`count`] share.
+fn parse_whole(text: &str) -> Result<u64, NotWhole> {
+    if let Ok(v) = text.parse::<u64>() {
+        return Ok(v);
+    }
+    match text.parse::<f64>() {
+        Ok(v) if v < 0.0 => Err(NotWhole::Negative),
+        Ok(v) if !v.is_finite() || v.fract() != 0.0 => Err(NotWhole::Fraction),
+        // 2^64 is exactly representable; below it the cast is exact for
+        // every whole f64.
+        Ok(v) if v < 18_446_744_073_709_551_616.0 => Ok(v as u64),
+        Ok(_) => Err(NotWhole::TooLarge),
+        Err(_) => Err(NotWhole::Text),
+    }
+}
+
 /// A whole number ≥ 0 for counts, sizes and seeds, written plainly (16)
 /// or in scientific notation when that is whole (1e3); negative,
 /// fractional and too large values are refused naming what was typed
 /// (clap's own parser says "invalid digit found in string").
 pub fn whole<T: TryFrom<u64>>(text: &str) -> Result<T, String> {
-    let value = match text.parse::<u64>() {
-        Ok(v) => v,
-        Err(_) => match text.parse::<f64>() {
-            Ok(v) if v < 0.0 => {
-                return Err(format!(
-                    "`{text}` is negative; expected a whole number >= 0"
-                ));
-            }
-            Ok(v) if !v.is_finite() || v.fract() != 0.0 => {
-                return Err(format!("`{text}` is not a whole number"));
-            }
-            // 2^64 is exactly representable; below it the cast is exact
-            // for every whole f64.
-            Ok(v) if v < 18_446_744_073_709_551_616.0 => v as u64,
-            Ok(_) => return Err(format!("`{text}` is larger than 2^64 - 1")),
-            Err(_) => {
-                return Err(format!(
-                    "`{text}` is not a whole number (write e.g. 16 or 1e3)"
-                ));
-            }
-        },
-    };
+    let value = parse_whole(text).map_err(|e| match e {
+        NotWhole::Negative => format!("`{text}` is negative; expected a whole number >= 0"),
+        NotWhole::Fraction => format!("`{text}` is not a whole number"),
+        NotWhole::TooLarge => format!("`{text}` is larger than 2^64 - 1"),
+        NotWhole::Text => format!("`{text}` is not a whole number (write e.g. 16 or 1e3)"),
+    })?;
     T::try_from(value).map_err(|_| format!("`{text}` is too large for this option"))
 }
 
@@ -133,24 +142,21 @@ pub fn whole<T: TryFrom<u64>>(text: &str) -> Result<T, String> {
 /// scientific notation when that is whole (1e6, 2.5e5); negative, fractional
 /// and huge values are refused with what was typed.
 pub fn count(text: &str) -> Result<usize, String> {
-    if let Ok(n) = text.parse::<usize>() {
-        return if n >= 1 {
-            Ok(n)
-        } else {
-            Err("a count of points must be at least 1".into())
-        };
-    }
-    match text.parse::<f64>() {
-        Ok(v) if v < 0.0 => Err(format!(
+    let too_many =
+        || format!("`{text}` is more points than this tool holds (fewer than 2^32 coordinates)");
+    match parse_whole(text) {
+        Ok(0) => Err("a count of points must be at least 1".into()),
+        // Written plainly, any usize passes here (the sampler refuses what
+        // it cannot hold); in scientific notation, below 2^52.
+        Ok(v) if v < 1 << 52 || text.parse::<usize>().is_ok() => {
+            usize::try_from(v).map_err(|_| too_many())
+        }
+        Ok(_) | Err(NotWhole::TooLarge) => Err(too_many()),
+        Err(NotWhole::Negative) => Err(format!(
             "`{text}` is negative; a count of points is a whole number >= 1"
         )),
-        Ok(v) if v.fract() != 0.0 => Err(format!("`{text}` is not a whole number of points")),
-        Ok(v) if v >= 1.0 && v < 2f64.powi(52) => Ok(v as usize),
-        Ok(v) if v >= 1.0 => Err(format!(
-            "`{text}` is more points than this tool holds (fewer than 2^32 coordinates)"
-        )),
-        Ok(_) => Err("a count of points must be at least 1".into()),
-        Err(_) => Err(format!(
+        Err(NotWhole::Fraction) => Err(format!("`{text}` is not a whole number of points")),
+        Err(NotWhole::Text) => Err(format!(
             "`{text}` is not a count of points (a whole number such as 1024 or 1e6)"
         )),
     }

@@ -68,8 +68,42 @@ impl Shard {
         Ok(Shard { index, count })
     }
 
-    fn owns(&self, item: usize) -> bool {
+    /// True for the items this shard draws: item ≡ i (mod n).
+    pub fn owns(&self, item: usize) -> bool {
         item % self.count == self.index
+    }
+
+    /// Checks that `shards` are every part of one split exactly once;
+    /// `same_run(j)` says whether the j-th belongs to the first one's run
+    /// (an `what`, e.g. "experiment").
+    ///
+    /// # Errors
+    /// A sentence naming the shard that is foreign, repeated or missing.
+    pub fn check_split(
+        shards: &[Shard],
+        same_run: impl Fn(usize) -> bool,
+        what: &str,
+    ) -> Result<(), String> {
+        let Some(first) = shards.first() else {
+            return Err("no shards to merge".into());
+        };
+        let count = first.count;
+        let mut seen = vec![false; count];
+        for (j, s) in shards.iter().enumerate() {
+            if !same_run(j) || s.count != count {
+                return Err(format!(
+                    "shard {}/{} belongs to another {what} or split than shard {}/{count}",
+                    s.index, s.count, first.index
+                ));
+            }
+            if std::mem::replace(&mut seen[s.index], true) {
+                return Err(format!("shard {}/{count} given twice", s.index));
+            }
+        }
+        match seen.iter().position(|s| !s) {
+            Some(missing) => Err(format!("shard {missing}/{count} is missing")),
+            None => Ok(()),
+        }
     }
 }
 
@@ -160,25 +194,13 @@ pub fn merge_shards(
         file: first.file.clone(),
         reason,
     };
-    let count = first.shard.count;
-    let mut seen = vec![false; count];
-    for s in shards {
-        if s.experiment != first.experiment || s.shard.count != count {
-            return Err(invalid(format!(
-                "shard {}/{} belongs to another experiment or split than shard {}/{}",
-                s.shard.index, s.shard.count, first.shard.index, count
-            )));
-        }
-        if std::mem::replace(&mut seen[s.shard.index], true) {
-            return Err(invalid(format!(
-                "shard {}/{count} given twice",
-                s.shard.index
-            )));
-        }
-    }
-    if let Some(missing) = seen.iter().position(|s| !s) {
-        return Err(invalid(format!("shard {missing}/{count} is missing")));
-    }
+    let parts: Vec<Shard> = shards.iter().map(|s| s.shard).collect();
+    Shard::check_split(
+        &parts,
+        |j| shards[j].experiment == first.experiment,
+        "experiment",
+    )
+    .map_err(invalid)?;
     let mut cells: Vec<Cell> = shards
         .iter()
         .flat_map(|s| s.cells.iter().cloned())

@@ -78,28 +78,19 @@ pub fn draw_shard(
 /// splits, a shard twice or missing, a set that is not a point set.
 pub fn merge_table_shards(shards: &[TableShard]) -> Result<(TableRun, Vec<PointSet>), String> {
     let first = shards.first().ok_or("no table shards to merge")?;
+    let parts: Vec<Shard> = shards.iter().map(|s| s.shard).collect();
+    Shard::check_split(
+        &parts,
+        |j| shards[j].run == first.run && shards[j].dim == first.dim,
+        "table run",
+    )?;
     let count = first.shard.count;
-    let mut seen = vec![false; count];
-    for s in shards {
-        if s.run != first.run || s.shard.count != count || s.dim != first.dim {
-            return Err(format!(
-                "shard {}/{} belongs to another table run or split than shard {}/{}",
-                s.shard.index, s.shard.count, first.shard.index, count
-            ));
-        }
-        if std::mem::replace(&mut seen[s.shard.index], true) {
-            return Err(format!("shard {}/{count} is given twice", s.shard.index));
-        }
-    }
-    if let Some(missing) = seen.iter().position(|&s| !s) {
-        return Err(format!("shard {missing}/{count} is missing"));
-    }
     let mut sets: Vec<Option<PointSet>> = vec![None; first.run.sets];
     for s in shards {
         for (r, coords) in &s.sets {
             let slot = sets
                 .get_mut(*r)
-                .filter(|_| r % count == s.shard.index)
+                .filter(|_| s.shard.owns(*r))
                 .ok_or_else(|| {
                     format!("shard {}/{count} holds set {r}, not its own", s.shard.index)
                 })?;
