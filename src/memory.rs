@@ -1,10 +1,20 @@
 //! One memory budget for every large allocation: sizes computed from user
 //! input are estimated before anything is allocated and refused, with the
-//! numbers, when they exceed what the machine can give.
+//! numbers, when they exceed what the process can get.
 //!
-//! The limit is `VARSPEC_MEMORY_MIB` when set, else 80 % of the memory
-//! the kernel reports available (`MemAvailable` in /proc/meminfo), else
-//! 8 GiB where that file does not exist.
+//! The limit is `VARSPEC_MEMORY_MIB` when set, else 80 % of the smallest of
+//! what the process may still use:
+//! - the memory the kernel reports available (`MemAvailable` in
+//!   /proc/meminfo);
+//! - the headroom of the process's memory cgroup and each of its ancestors
+//!   (v2: `memory.max − memory.current`; v1: `memory.limit_in_bytes −
+//!   memory.usage_in_bytes`), the limit a container or a Slurm job sets;
+//! - the headroom of the address-space limit (`ulimit -v`, the soft
+//!   `Max address space` of /proc/self/limits, minus `VmSize`).
+//!
+//! Where none of these can be read (not Linux), 8 GiB.
+
+use std::path::Path;
 
 /// The budget in MiB.
 pub fn limit_mib() -> u64 {
@@ -14,14 +24,91 @@ pub fn limit_mib() -> u64 {
     {
         return v;
     }
-    available_mib().map_or(8 * 1024, |a| a * 4 / 5)
+    headroom_bytes().map_or(8 * 1024, |b| b / (1 << 20) * 4 / 5)
 }
 
-fn available_mib() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024)
+/// The smallest headroom the kernel reports, in bytes.
+fn headroom_bytes() -> Option<u64> {
+    let read = |p: &str| std::fs::read_to_string(p).ok();
+    let meminfo = read("/proc/meminfo").and_then(|t| meminfo_available(&t));
+    let cgroup =
+        read("/proc/self/cgroup").and_then(|t| cgroup_headroom(&t, Path::new("/sys/fs/cgroup")));
+    let address = match (read("/proc/self/limits"), read("/proc/self/status")) {
+        (Some(limits), Some(status)) => address_space_headroom(&limits, &status),
+        _ => None,
+    };
+    [meminfo, cgroup, address].into_iter().flatten().min()
+}
+
+/// `MemAvailable` of /proc/meminfo, in bytes.
+fn meminfo_available(meminfo: &str) -> Option<u64> {
+    kib_field(meminfo, "MemAvailable:")
+}
+
+/// A `Name:   123 kB` field, in bytes.
+fn kib_field(text: &str, name: &str) -> Option<u64> {
+    let line = text.lines().find(|l| l.starts_with(name))?;
+    let kib: u64 = line[name.len()..].split_whitespace().next()?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+/// A cgroup limit file's value; `max` (v2) and v1's near-2⁶³ "unlimited"
+/// are no limit.
+fn limit_value(text: &str) -> Option<u64> {
+    let v: u64 = text.trim().parse().ok()?;
+    (v < 1 << 62).then_some(v)
+}
+
+/// The smallest `limit − usage` over the process's memory cgroup and its
+/// ancestors, from /proc/self/cgroup's text and the cgroup mount `root`.
+fn cgroup_headroom(proc_cgroup: &str, root: &Path) -> Option<u64> {
+    let mut best: Option<u64> = None;
+    for line in proc_cgroup.lines() {
+        let mut parts = line.splitn(3, ':');
+        let (_, controllers, path) = (parts.next()?, parts.next()?, parts.next()?);
+        let (base, limit_file, usage_file) = if controllers.is_empty() {
+            (root.to_path_buf(), "memory.max", "memory.current")
+        } else if controllers.split(',').any(|c| c == "memory") {
+            (
+                root.join("memory"),
+                "memory.limit_in_bytes",
+                "memory.usage_in_bytes",
+            )
+        } else {
+            continue;
+        };
+        let mut dir = base.join(path.trim_start_matches('/'));
+        loop {
+            let limit = std::fs::read_to_string(dir.join(limit_file)).ok();
+            if let Some(limit) = limit.as_deref().and_then(limit_value) {
+                let usage = std::fs::read_to_string(dir.join(usage_file))
+                    .ok()
+                    .and_then(|u| u.trim().parse::<u64>().ok())
+                    .unwrap_or(0);
+                let room = limit.saturating_sub(usage);
+                best = Some(best.map_or(room, |b| b.min(room)));
+            }
+            if dir == base || !dir.pop() {
+                break;
+            }
+        }
+    }
+    best
+}
+
+/// The soft address-space limit of /proc/self/limits minus the process's
+/// `VmSize` (/proc/self/status), in bytes; None when unlimited.
+fn address_space_headroom(limits: &str, status: &str) -> Option<u64> {
+    let line = limits
+        .lines()
+        .find(|l| l.starts_with("Max address space"))?;
+    let soft: u64 = line["Max address space".len()..]
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()?;
+    let used = kib_field(status, "VmSize:").unwrap_or(0);
+    Some(soft.saturating_sub(used))
 }
 
 /// What does not fit.
@@ -86,5 +173,59 @@ mod tests {
         assert!(message.contains("lower --res"), "{message}");
         assert_eq!(check("x", None, "h").unwrap_err().needed_mib, u64::MAX);
         check("a small table", Some(1024.0), "").unwrap();
+    }
+
+    #[test]
+    fn meminfo_and_address_space_fields_are_read_in_bytes() {
+        let meminfo =
+            "MemTotal:       24000000 kB\nMemFree:  100 kB\nMemAvailable:   20000000 kB\n";
+        assert_eq!(meminfo_available(meminfo), Some(20_000_000 * 1024));
+        assert_eq!(meminfo_available("MemTotal: 5 kB\n"), None);
+        let limits = "Limit                     Soft Limit           Hard Limit           Units\n\
+                      Max stack size            8388608              unlimited            bytes\n\
+                      Max address space         2147483648           unlimited            bytes\n";
+        let status = "Name:\tvarspec\nVmPeak:\t  600000 kB\nVmSize:\t  524288 kB\n";
+        assert_eq!(
+            address_space_headroom(limits, status),
+            Some(2_147_483_648 - 524_288 * 1024)
+        );
+        let unlimited = limits.replace("2147483648", "unlimited");
+        assert_eq!(address_space_headroom(&unlimited, status), None);
+    }
+
+    #[test]
+    fn cgroup_headroom_is_the_smallest_over_the_ancestors() {
+        let root = std::env::temp_dir().join(format!("varspec-cgroup-{}", std::process::id()));
+        let job = root.join("slurm/job_7");
+        std::fs::create_dir_all(&job).unwrap();
+        let write =
+            |dir: &Path, name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
+        // v2: the job may use 3 GiB and has 1 GiB; its parent allows more.
+        write(&job, "memory.max", "3221225472\n");
+        write(&job, "memory.current", "1073741824\n");
+        write(&root.join("slurm"), "memory.max", "max\n");
+        write(&root, "memory.max", "17179869184\n");
+        write(&root, "memory.current", "0\n");
+        assert_eq!(
+            cgroup_headroom("0::/slurm/job_7\n", &root),
+            Some(2 * 1024 * 1024 * 1024)
+        );
+        // v1: the memory controller's own hierarchy; "unlimited" ignored.
+        let v1 = root.join("memory/box");
+        std::fs::create_dir_all(&v1).unwrap();
+        write(&v1, "memory.limit_in_bytes", "1000000\n");
+        write(&v1, "memory.usage_in_bytes", "400000\n");
+        write(
+            &root.join("memory"),
+            "memory.limit_in_bytes",
+            "9223372036854771712\n",
+        );
+        assert_eq!(
+            cgroup_headroom("4:cpu,cpuacct:/box\n3:memory:/box\n", &root),
+            Some(600_000)
+        );
+        // No memory controller named, nothing read.
+        assert_eq!(cgroup_headroom("2:cpu:/box\n", &root), None);
+        std::fs::remove_dir_all(&root).unwrap();
     }
 }

@@ -1,6 +1,7 @@
 //! Fault tests (issue 14 §4): a write killed with SIGKILL halfway leaves
 //! the old file whole, and the next write to the same path removes the
-//! killed run's temporary file.
+//! killed run's temporary file; an address-space limit lowers the memory
+//! budget so a request beyond it is refused instead of aborting.
 
 mod common;
 
@@ -71,4 +72,31 @@ fn a_killed_write_leaves_the_old_file_whole_and_no_temporary_behind() {
         temporaries(&dir)
     );
     assert_ne!(std::fs::read(&target).unwrap(), before);
+}
+
+/// The memory budget follows an address-space limit (`ulimit -v`), not only
+/// the machine's free memory: a 4.5 GiB spectrum that this machine could
+/// hold is refused, with the numbers, under a 2 GiB limit instead of
+/// aborting when the allocation fails.
+#[test]
+fn an_address_space_limit_lowers_the_memory_budget() {
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 2097152 && exec \"$0\" spectrum --sampler jitter -n 64 --res 4096")
+        .arg(env!("CARGO_BIN_EXE_varspec"))
+        .env_remove("VARSPEC_MEMORY_MIB")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let limit: u64 = stderr
+        .split("more than the ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no budget named: {stderr}"));
+    assert!(
+        limit <= 2048 && stderr.contains("needs about"),
+        "budget {limit} MiB under a 2 GiB address-space limit: {stderr}"
+    );
 }

@@ -4,6 +4,8 @@
 //! Statistical checks use fixed seeds and two-sided 99.9% intervals
 //! (z = 3.29); each message prints the interval.
 
+mod common;
+
 use varspec::integrands;
 use varspec::registry;
 use varspec::samplers::{self, Sampler};
@@ -77,13 +79,16 @@ fn spatial_fourier_and_empirical_forms_agree_with_a_random_count() {
     let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(sets[r].clone()) };
     let s = spatial(f.as_ref(), sets.len(), lend).unwrap();
     let four = fourier(f.as_ref(), 255, 1e-10, sets.len(), lend).unwrap();
-    // Same sets: the two forms are one identity, up to the Fourier tail.
-    let tol = four.truncation_bound + s.rounding_bound + 1e-9 * s.variance;
-    assert!(
-        (s.variance - four.variance).abs() <= tol,
-        "spatial {} vs Fourier {} (tail bound {tol})",
-        s.variance,
-        four.variance
+    // Same sets: both forms against a direct DFT with weights 1/λ and the
+    // rigorous limits of the tail (tests/common/direct.rs).
+    common::direct::check_fourier(
+        "isotropic jitter",
+        f.as_ref(),
+        &sets,
+        255,
+        1e-10,
+        &four,
+        Some(&s),
     );
     assert!(four.count_term > 0.0, "a random count adds variance");
     // Independent realizations: the empirical variance of (1/λ) Σ f.

@@ -96,7 +96,7 @@ pub fn all_or_nothing<T, E: From<WriteError>>(work: impl FnOnce() -> Result<T, E
     }
     for (i, item) in staged.iter().enumerate() {
         if let Staged::Rename { path, tmp, target } = item
-            && let Err(cause) = fs::rename(tmp, target).and_then(|()| sync_folder(target))
+            && let Err(cause) = rename_durably(tmp, target)
         {
             discard(&staged[i..]);
             return Err(WriteError {
@@ -212,8 +212,7 @@ where
         if staging() {
             return Ok(true);
         }
-        fs::rename(&tmp, &target)?;
-        sync_folder(&target).map(|()| false)
+        rename_durably(&tmp, &target).map(|()| false)
     })();
     match result {
         Ok(true) => {
@@ -320,19 +319,23 @@ where
     out.flush()
 }
 
-/// Makes the rename durable: sync the folder that holds `path` (Unix; a
-/// no-op where folders cannot be opened).
-fn sync_folder(path: &Path) -> io::Result<()> {
+/// Renames the synced temporary over `target`, then syncs the folder that
+/// holds it so the rename itself survives a crash (Unix; folders cannot be
+/// opened elsewhere).
+fn rename_durably(tmp: &Path, target: &Path) -> io::Result<()> {
+    fs::rename(tmp, target)?;
+    #[cfg(test)]
+    tests::JOURNAL.with(|j| j.borrow_mut().push(format!("rename {}", target.display())));
     #[cfg(unix)]
     {
-        let dir = match path.parent() {
+        let dir = match target.parent() {
             Some(d) if !d.as_os_str().is_empty() => d,
             _ => Path::new("."),
         };
         File::open(dir)?.sync_all()?;
+        #[cfg(test)]
+        tests::JOURNAL.with(|j| j.borrow_mut().push(format!("sync {}", dir.display())));
     }
-    #[cfg(not(unix))]
-    let _ = path;
     Ok(())
 }
 
@@ -386,6 +389,37 @@ fn temporary_sibling(path: &Path) -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    thread_local! {
+        /// What `rename_durably` did on this thread, in order.
+        pub(super) static JOURNAL: std::cell::RefCell<Vec<String>> =
+            const { std::cell::RefCell::new(Vec::new()) };
+    }
+
+    #[test]
+    fn every_rename_is_followed_by_a_sync_of_its_folder() {
+        let dir = std::env::temp_dir().join(format!("varspec-atomic-sync-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("a.csv"), dir.join("b.csv"));
+        JOURNAL.with(|j| j.borrow_mut().clear());
+        write_atomic(&a, |w| w.write_all(b"one")).unwrap();
+        all_or_nothing(|| -> Result<(), WriteError> {
+            write_atomic(&a, |w| w.write_all(b"two"))?;
+            write_atomic(&b, |w| w.write_all(b"three"))
+        })
+        .unwrap();
+        let expected: Vec<String> = [&a, &a, &b]
+            .iter()
+            .flat_map(|p| {
+                [
+                    format!("rename {}", p.display()),
+                    format!("sync {}", dir.display()),
+                ]
+            })
+            .collect();
+        assert_eq!(JOURNAL.with(|j| j.borrow().clone()), expected);
+        fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn replaces_whole_file_and_leaves_no_temporary() {

@@ -63,5 +63,6 @@ pub fn assert_fails(args: &[&str], phrase: &str) {
     );
     assert!(!err.contains("panicked"), "{args:?}: {err}");
 }
+pub mod direct;
 pub mod fuzz;
 pub mod hostile;
