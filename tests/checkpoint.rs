@@ -134,6 +134,8 @@ fn a_killed_descent_continues_from_its_checkpoint_to_the_same_set() {
             "400",
             "--rel-tol",
             "0",
+            "--sets",
+            "1",
             "-o",
             out,
         ]

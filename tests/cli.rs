@@ -62,9 +62,11 @@ fn output_file_matches_stdout_and_reads_back() {
     let sets = varspec::io::read_point_sets(&path).unwrap();
     assert_eq!((sets.len(), sets[0].len(), sets[0].dim()), (3, 16, 2));
     // Scientific notation names a whole count too.
-    let sci = varspec(&["sample", "random", "-n", "1e3"]);
+    let sci = varspec(&["sample", "random", "-n", "1e3", "--sets", "1"]);
     assert_eq!(String::from_utf8_lossy(&sci.stdout).lines().count(), 1001);
-    let utk = varspec(&["sample", "sobol", "-n", "8", "--format", "utk"]);
+    let utk = varspec(&[
+        "sample", "sobol", "-n", "8", "--sets", "1", "--format", "utk",
+    ]);
     let text = String::from_utf8(utk.stdout).unwrap();
     assert_eq!(text.lines().count(), 8);
     assert!(text.lines().all(|l| l.split(' ').count() == 2));
@@ -871,4 +873,78 @@ fn a_closed_standard_output_is_not_an_error() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{:?}: {err}", out.status);
     assert!(!err.contains("panicked"), "{err}");
+}
+
+/// `bench render` and `bench predict` write CSV through serde records that
+/// the csv crate reads back: the header names the columns, both BVHs find
+/// the same hits, and the spatial row is the exact reference of its group.
+#[test]
+fn bench_tables_are_csv_with_named_columns() {
+    let dir = temp_dir("bench-csv");
+    let render = dir.join("render.csv");
+    let run = varspec_with(
+        &[
+            "bench",
+            "render",
+            "--subdivisions",
+            "1",
+            "--csv",
+            render.to_str().unwrap(),
+        ],
+        Some("2"),
+    );
+    assert!(run.status.success(), "{run:?}");
+    let mut r = csv::Reader::from_path(&render).unwrap();
+    assert_eq!(
+        r.headers().unwrap().iter().collect::<Vec<_>>(),
+        [
+            "bvh",
+            "triangles",
+            "threads",
+            "build_seconds",
+            "camera_rays_per_second",
+            "shadow_rays_per_second",
+            "hits"
+        ]
+    );
+    let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
+    assert_eq!(rows.len(), 2);
+    assert_eq!((&rows[0][0], &rows[1][0]), ("cwbvh", "bvh2"));
+    assert_eq!(
+        rows[0][6], rows[1][6],
+        "the two BVHs must hit the same rays"
+    );
+    assert_eq!(&rows[0][2], "2");
+    assert!(rows[0][4].parse::<f64>().unwrap() > 0.0);
+
+    let predict = dir.join("predict.csv");
+    let run = varspec(&[
+        "bench",
+        "predict",
+        "--quick",
+        "--csv",
+        predict.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{run:?}");
+    let mut r = csv::Reader::from_path(&predict).unwrap();
+    assert_eq!(
+        r.headers().unwrap().iter().collect::<Vec<_>>(),
+        [
+            "case",
+            "method",
+            "seconds",
+            "variance",
+            "relative_error",
+            "threads"
+        ]
+    );
+    let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
+    let spatial: Vec<_> = rows
+        .iter()
+        .filter(|r| r[1].starts_with("spatial"))
+        .collect();
+    assert_eq!(spatial.len(), 2, "one exact row per integrand");
+    assert!(spatial.iter().all(|r| r[4].parse::<f64>().unwrap() == 0.0));
+    // A comma inside a field is quoted, not a column break.
+    assert!(rows.iter().any(|r| r[1] == *"fourier K=64, no tail"));
 }

@@ -32,6 +32,10 @@ fn renders_are_identical_on_one_and_two_threads_and_write_every_output() {
                 &p("var.pfm"),
                 "--variance-png",
                 &p("var.png"),
+                "--variance-npy",
+                &p("var.npy"),
+                "--npy",
+                &p("img.npy"),
                 "--analysis",
                 &p("an.csv"),
                 "--summary",
@@ -59,6 +63,27 @@ fn renders_are_identical_on_one_and_two_threads_and_write_every_output() {
     let pfm = std::fs::read(dir.join("one-img.pfm")).unwrap();
     assert!(pfm.starts_with(b"Pf\n256 256\n-1.0\n"));
     assert_eq!(pfm.len(), 16 + 4 * 256 * 256);
+    // The .npy maps hold the same pixels as the PFMs (which store f32 rows
+    // bottom-up), top row first, as float64 [height, width].
+    for (npy, pfm) in [("img.npy", "img.pfm"), ("var.npy", "var.pfm")] {
+        let bytes = std::fs::read(dir.join(format!("one-{npy}"))).unwrap();
+        let array = npyz::NpyFile::new(&bytes[..]).unwrap();
+        assert_eq!(array.shape(), &[256, 256], "{npy}");
+        let values: Vec<f64> = array.into_vec().unwrap();
+        let floats = std::fs::read(dir.join(format!("one-{pfm}"))).unwrap();
+        let pfm_value = |row: usize, col: usize| {
+            let i = 16 + 4 * ((255 - row) * 256 + col);
+            f32::from_le_bytes(floats[i..i + 4].try_into().unwrap())
+        };
+        for (row, col) in [(0, 0), (3, 200), (128, 77), (255, 255)] {
+            assert_eq!(
+                values[row * 256 + col] as f32,
+                pfm_value(row, col),
+                "{npy} ({row}, {col})"
+            );
+        }
+        assert!(values.iter().any(|&v| v > 0.0), "{npy} is not all zero");
+    }
     let csv = std::fs::read_to_string(dir.join("one-an.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 256 * 256);
     assert!(

@@ -28,6 +28,11 @@ pub fn dims(text: &str, count: usize) -> anyhow::Result<Vec<usize>> {
     Ok(dims)
 }
 
+/// Realizations drawn when --sets is not given, the same in every command
+/// that draws sets of a sampler (sample, predict, converge, spectrum, pcf,
+/// optimize points, tables).
+pub const DEFAULT_SETS: usize = 16;
+
 /// How realizations of a sampler are drawn: how many, from which seed, with
 /// which sampler parameters (shared by the commands that draw sets).
 #[derive(clap::Args)]
@@ -50,9 +55,9 @@ impl DrawArgs {
         self.seed_given.unwrap_or(0)
     }
 
-    /// Realizations to draw: --sets, default 16.
+    /// Realizations to draw: --sets, default [`DEFAULT_SETS`].
     pub fn sets(&self) -> usize {
-        self.sets_given.unwrap_or(16)
+        self.sets_given.unwrap_or(DEFAULT_SETS)
     }
 
     /// Refuses more sets than the machine can hold results for: analyses

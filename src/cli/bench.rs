@@ -8,7 +8,7 @@ use clap::Subcommand;
 use rustfft::num_complex::Complex64;
 
 use varspec::integrands;
-use varspec::io::write_atomic;
+use varspec::io::{write_atomic, write_csv_rows};
 use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::spectrum::dft::sample_spectrum;
@@ -113,9 +113,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
 
     let text = bench_scene(a.subdivisions);
     let threads = rayon::current_num_threads();
-    let mut out = String::from(
-        "bvh,triangles,threads,build_seconds,camera_rays_per_second,shadow_rays_per_second,hits\n",
-    );
+    let mut out: Vec<RenderRow> = Vec::new();
     println!(
         "{:<6} {:>10} {:>8} {:>12} {:>18} {:>18}",
         "bvh", "triangles", "threads", "build (s)", "camera rays/s", "shadow rays/s"
@@ -178,22 +176,53 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
             "{label:<6} {:>10} {threads:>8} {build:>12.3} {camera_rate:>18.3e} {shadow_rate:>18.3e}",
             scene.geometry().triangle_count()
         );
-        out += &format!(
-            "{label},{},{threads},{build},{camera_rate},{shadow_rate},{hits}\n",
-            scene.geometry().triangle_count()
-        );
+        out.push(RenderRow {
+            bvh: label,
+            triangles: scene.geometry().triangle_count(),
+            threads,
+            build_seconds: build,
+            camera_rays_per_second: camera_rate,
+            shadow_rays_per_second: shadow_rate,
+            hits,
+        });
     }
-    write_atomic(&a.csv, |w| w.write_all(out.as_bytes()))?;
+    write_atomic(&a.csv, |w| write_csv_rows(w, &out))?;
     println!("wrote {}", a.csv.display());
     Ok(())
 }
 
+/// One row of `bench spectrum`'s CSV.
+#[derive(serde::Serialize)]
 struct Row {
     case: String,
     method: String,
     seconds: f64,
     max_power_error: Option<f64>,
     max_rel_error: Option<f64>,
+    threads: usize,
+}
+
+/// One row of `bench render`'s CSV.
+#[derive(serde::Serialize)]
+struct RenderRow {
+    bvh: &'static str,
+    triangles: usize,
+    threads: usize,
+    build_seconds: f64,
+    camera_rays_per_second: f64,
+    shadow_rays_per_second: f64,
+    hits: usize,
+}
+
+/// One row of `bench predict`'s CSV.
+#[derive(serde::Serialize)]
+struct PredictRow {
+    case: String,
+    method: String,
+    seconds: f64,
+    variance: f64,
+    relative_error: f64,
+    threads: usize,
 }
 
 /// Best of `repeats` wall times of `f`.
@@ -245,6 +274,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
             seconds: direct_s,
             max_power_error: Some(0.0),
             max_rel_error: Some(0.0),
+            threads,
         },
     );
     for tol in [1e-3, 1e-6, 1e-9, 1e-12] {
@@ -271,6 +301,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
                 seconds: secs,
                 max_power_error: Some(dp),
                 max_rel_error: Some(ds),
+                threads,
             },
         );
     }
@@ -302,6 +333,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
             seconds: secs,
             max_power_error: None,
             max_rel_error: None,
+            threads,
         },
     );
 
@@ -348,6 +380,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
                 seconds,
                 max_power_error: None,
                 max_rel_error: (tol > 1e-12).then_some(error),
+                threads,
             };
             let error = max_difference(&out, &exact) / n as f64;
             push(&mut rows, row("", secs, error));
@@ -361,25 +394,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
             push(&mut rows, row("type 2 ", secs, error));
         }
     }
-    write_atomic(&a.csv, |w| {
-        writeln!(
-            w,
-            "case,method,seconds,max_power_error,max_rel_error,threads"
-        )?;
-        for r in &rows {
-            let opt = |v: Option<f64>| v.map_or(String::new(), |e| format!("{e:e}"));
-            writeln!(
-                w,
-                "\"{}\",\"{}\",{},{},{},{threads}",
-                r.case,
-                r.method,
-                r.seconds,
-                opt(r.max_power_error),
-                opt(r.max_rel_error)
-            )?;
-        }
-        Ok(())
-    })?;
+    write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
     println!("wrote {}", a.csv.display());
     Ok(())
 }
@@ -394,7 +409,7 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
         "{:<40} {:<26} {:>10} {:>12} {:>11}",
         "case", "method", "seconds", "variance", "rel. error"
     );
-    let mut lines = vec!["case,method,seconds,variance,relative_error,threads".to_string()];
+    let mut rows: Vec<PredictRow> = Vec::new();
     let ns: &[usize] = if a.quick { &[1024] } else { &[1024, 4096] };
     for &n in ns {
         let set = registry::build("jitter", n, Some(2), &[])?.sample(&mut set_rng(11, 0))?;
@@ -406,9 +421,14 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
             let mut row = |method: String, seconds: f64, variance: f64| {
                 let rel = (variance - exact) / exact;
                 println!("{case:<40} {method:<26} {seconds:>10.4} {variance:>12.5e} {rel:>11.2e}");
-                lines.push(format!(
-                    "\"{case}\",\"{method}\",{seconds},{variance:e},{rel:e},{threads}"
-                ));
+                rows.push(PredictRow {
+                    case: case.clone(),
+                    method,
+                    seconds,
+                    variance,
+                    relative_error: rel,
+                    threads,
+                });
             };
             row(format!("spatial (rounding {rounding:.0e})"), secs, exact);
             for res in [64, 128, 256, 512] {
@@ -438,12 +458,7 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
             }
         }
     }
-    write_atomic(&a.csv, |w| {
-        for l in &lines {
-            writeln!(w, "{l}")?;
-        }
-        Ok(())
-    })?;
+    write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
     println!("wrote {}", a.csv.display());
     Ok(())
 }

@@ -46,7 +46,7 @@ pub struct ShearArgs {
     integrand: String,
     /// Sheared sets written with -o (the search itself uses the expected
     /// variance over the sampler's randomness, not these sets).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 16)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = super::args::DEFAULT_SETS)]
     sets: usize,
     /// Seed of the written sets, of the independent check and of any
     /// realizations behind an estimated half.
@@ -87,7 +87,7 @@ pub struct PointsArgs {
     #[arg(long)]
     target: String,
     /// Independent realizations, optimized in parallel.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = super::args::DEFAULT_SETS)]
     sets: usize,
     /// Maximum iterations per set (default 1000 on the torus, 2000 on the square).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]

@@ -54,12 +54,19 @@ pub struct Args {
     /// Float image (PFM) of the (mean) image.
     #[arg(long)]
     pfm: Option<PathBuf>,
+    /// NumPy array (.npy, float64 [height, width], top row first) of the
+    /// (mean) image.
+    #[arg(long)]
+    npy: Option<PathBuf>,
     /// Heat map PNG of log10 per-pixel variance, with a colour bar.
     #[arg(long)]
     variance_png: Option<PathBuf>,
     /// Float image (PFM) of the per-pixel variance.
     #[arg(long)]
     variance_pfm: Option<PathBuf>,
+    /// NumPy array (.npy, float64 [height, width]) of the per-pixel variance.
+    #[arg(long)]
+    variance_npy: Option<PathBuf>,
     /// Reference image (PFM) for the MSE in the summary.
     #[arg(long)]
     reference: Option<PathBuf>,
@@ -93,7 +100,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.renders == 0 {
         bail!("--renders must be at least 1");
     }
-    if a.renders < 2 && (a.variance_png.is_some() || a.variance_pfm.is_some()) {
+    if a.renders < 2
+        && (a.variance_png.is_some() || a.variance_pfm.is_some() || a.variance_npy.is_some())
+    {
         bail!("a variance needs --renders 2 or more");
     }
     let policy = match a.shear.as_str() {
@@ -119,6 +128,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.pfm.as_deref(),
         a.variance_png.as_deref(),
         a.variance_pfm.as_deref(),
+        a.npy.as_deref(),
+        a.variance_npy.as_deref(),
         a.summary.as_deref(),
         a.analysis.as_deref(),
         a.shear_png.as_deref(),
@@ -172,6 +183,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(path) = &a.pfm {
         image.write_pfm(path)?;
     }
+    if let Some(path) = &a.npy {
+        image.write_npy(path)?;
+    }
     let reference = match &a.reference {
         Some(path) => {
             let r = GreyImage::read_pfm(path).map_err(anyhow::Error::msg)?;
@@ -197,6 +211,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(var) = &variance {
         if let Some(path) = &a.variance_pfm {
             var.write_pfm(path)?;
+        }
+        if let Some(path) = &a.variance_npy {
+            var.write_npy(path)?;
         }
         if let Some(path) = &a.variance_png {
             var.write_variance_png(

@@ -62,7 +62,7 @@ pub struct Args {
     #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Number of independent realizations.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = args::DEFAULT_SETS)]
     sets: usize,
     /// Sampler parameter key=value (repeatable; see --list).
     #[arg(long = "param", value_parser = args::key_value)]

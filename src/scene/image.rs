@@ -29,6 +29,17 @@ impl GreyImage {
         write_atomic(path, |w| self.pfm(w)).map_err(Error::from)
     }
 
+    /// Writes a NumPy `.npy` array of shape [height, width], float64, row 0
+    /// at the top (`numpy.load` gives the image as it is shown).
+    ///
+    /// # Errors
+    /// [`Error::Write`] naming `path`.
+    pub fn write_npy(&self, path: &Path) -> Result<(), Error> {
+        let shape = [self.height as u64, self.width as u64];
+        write_atomic(path, |w| crate::io::npy::write_npy(w, &shape, &self.pixels))
+            .map_err(Error::from)
+    }
+
     fn pfm(&self, w: &mut dyn Write) -> io::Result<()> {
         write!(w, "Pf\n{} {}\n-1.0\n", self.width, self.height)?;
         for row in self.pixels.chunks_exact(self.width).rev() {
