@@ -535,6 +535,42 @@ fn the_main_job_writes_a_self_contained_report() {
             && spatial <= jitter["ci_high"].as_f64().unwrap(),
         "{jitter}"
     );
+    // The commands the page prints give its numbers: run them for CMJ.
+    let commands: Vec<&str> = report["predict"]["commands"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_str().unwrap())
+        .collect();
+    let file = dir.join("cmj.csv");
+    let mut json = None;
+    for prefix in ["varspec sample cmj ", "varspec predict cmj.csv "] {
+        let line = commands.iter().find(|c| c.starts_with(prefix)).unwrap();
+        let mut args: Vec<&str> = line.split_whitespace().skip(1).collect();
+        for a in args.iter_mut().filter(|a| **a == "cmj.csv") {
+            *a = file.to_str().unwrap();
+        }
+        if prefix.contains("predict") {
+            args.push("--json");
+        }
+        let run = varspec(&args);
+        assert!(run.status.success(), "{line}: {run:?}");
+        json = Some(run.stdout);
+    }
+    let printed: serde_json::Value = serde_json::from_slice(&json.unwrap()).unwrap();
+    let cmj = &rows[2];
+    assert_eq!(cmj["sampler"], "cmj");
+    for (column, method) in [
+        ("fourier", "fourier"),
+        ("spatial", "spatial"),
+        ("empirical", "empirical"),
+    ] {
+        assert_eq!(
+            cmj[column].as_f64(),
+            printed[method]["variance"].as_f64(),
+            "the page's {column} column vs its printed predict command"
+        );
+    }
     let scene = &report["scene"];
     assert!(scene["reduction"].as_f64().unwrap() > 1.5, "{scene}");
     assert!(

@@ -12,7 +12,9 @@ use varspec::PointSet;
 use varspec::integrands::{self, Integrand};
 use varspec::scene::pixel::PixelIntegrand;
 use varspec::source::SourceError;
-use varspec::variance::{VarianceError, empirical, fourier_parts, radial_from, spatial};
+use varspec::variance::{
+    DEFAULT_SHIFT_SEED, VarianceError, empirical, fourier_parts, radial_from, spatial,
+};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum MethodArg {
@@ -178,8 +180,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if wants(MethodArg::Empirical) {
         let start = Instant::now();
-        let seed = 0x454d_5049_5249_4341;
-        let e = empirical(f.as_ref(), a.realizations, seed, |r| {
+        let e = empirical(f.as_ref(), a.realizations, DEFAULT_SHIFT_SEED, |r| {
             source.get_cyclic(r).map_err(|e| lift(r, e))
         })?;
         out.insert(

@@ -26,7 +26,7 @@ use crate::spectrum::radial::radial_profile;
 use crate::spectrum::{FrequencyBox, Method, expected_power};
 use crate::square::design::{closest_pair_ratio, default_options, design, parse_target};
 use crate::square::{Family, family_mse};
-use crate::variance::{VarianceError, empirical, fourier, spatial};
+use crate::variance::{DEFAULT_SHIFT_SEED, VarianceError, empirical, fourier, spatial};
 
 /// What can stop the tour.
 #[derive(Debug, thiserror::Error)]
@@ -360,7 +360,9 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
         let lend = |r: usize| Ok::<_, VarianceError>(sets[r].clone());
         let fe = fourier(f.as_ref(), half, 1e-10, sets.len(), lend).map_err(at("Fourier form"))?;
         let se = spatial(f.as_ref(), sets.len(), lend).map_err(at("spatial form"))?;
-        let ee = empirical(f.as_ref(), realizations, o.seed ^ 0xe3, |r| {
+        // As `predict FILE --realizations R` on these sets (cyclic, the
+        // default shift seed): the printed commands give these numbers.
+        let ee = empirical(f.as_ref(), realizations, DEFAULT_SHIFT_SEED, |r| {
             Ok::<_, VarianceError>(&sets[r % sets.len()])
         })
         .map_err(at("empirical form"))?;
@@ -436,14 +438,23 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
     });
     let commands = vec![
         format!(
-            "varspec predict --sampler cmj -n {} --sets {} --seed {} --integrand {} --res 256",
-            o.n, o.sets, o.seed, o.integrand
+            "varspec sample cmj -n {} --sets {} --seed {} -o cmj.csv",
+            o.n, o.sets, o.seed
+        ),
+        format!(
+            "varspec predict cmj.csv --integrand {} --res {} --realizations {realizations}",
+            o.integrand,
+            2 * half + 1
         ),
         format!(
             "varspec sample blue-noise -n {} --sets {} --seed {} -o bn.csv",
             o.n, o.sets, o.seed
         ),
-        format!("varspec predict bn.csv --integrand {}", o.integrand),
+        format!(
+            "varspec predict bn.csv --integrand {} --res {} --realizations {realizations}",
+            o.integrand,
+            2 * half + 1
+        ),
         format!(
             "varspec spectrum --sampler jitter -n {} --sets {} --res 64 --png s.png --radial r.csv",
             o.n, o.sets

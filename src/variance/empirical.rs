@@ -51,6 +51,11 @@ fn estimate(f: &dyn Integrand, set: &PointSet, shift: &[f64]) -> f64 {
     acc.value() / set.intensity()
 }
 
+/// The seed of the shifts when none is given (`predict --method
+/// empirical`, the report's empirical column): one constant, so the report's
+/// numbers are what the command it prints gives.
+pub const DEFAULT_SHIFT_SEED: u64 = 0x454d_5049_5249_4341;
+
 /// The empirical variance of Î over R realizations; realization r is
 /// `realization(r)` (owned or borrowed: a fixed set can be lent R times),
 /// shifted by a uniform s drawn from stream (seed, r).
