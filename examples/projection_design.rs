@@ -9,13 +9,13 @@
 //! ```
 
 use varspec::integrands;
+use varspec::neighbours::closest_pair_ratio;
 use varspec::optimize::projections::{ProjectionObjective, parse_projections};
 use varspec::optimize::shear::Sheared;
 use varspec::optimize::{AdamOptions, Domain, adam};
 use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::samplers::Sampler;
-use varspec::square::design::closest_pair_ratio;
 use varspec::variance::{VarianceError, empirical_shifting};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -13,9 +13,10 @@
 use std::time::Instant;
 
 use varspec::PointSet;
+use varspec::neighbours::closest_pair_ratio;
 use varspec::registry;
 use varspec::rng::{set_rng, uniform};
-use varspec::square::design::{closest_pair_ratio, default_options, design, parse_target};
+use varspec::square::design::{default_options, design, parse_target};
 use varspec::square::{Family, family_mse};
 
 const MEMBERS: usize = 2048;

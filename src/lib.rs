@@ -30,6 +30,7 @@
 //! ```
 
 pub mod baseline;
+pub mod design;
 pub mod error;
 pub mod experiment;
 pub mod integrands;

@@ -111,3 +111,13 @@ pub fn nearest_neighbour_distances(points: &PointSet) -> Vec<f64> {
         })
         .collect()
 }
+
+/// The closest pair of `set` (toroidal distance) over the hexagonal
+/// spacing √(2/(√3 N)), the densest packing's.
+pub fn closest_pair_ratio(set: &PointSet) -> f64 {
+    let hex = (2.0 / (3f64.sqrt() * set.len().max(1) as f64)).sqrt();
+    nearest_neighbour_distances(set)
+        .into_iter()
+        .fold(f64::INFINITY, f64::min)
+        / hex
+}

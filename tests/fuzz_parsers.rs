@@ -1,7 +1,8 @@
 //! Every parser of user input against mutated inputs (issue 14): no panic
 //! and no input slower than a second. Bounded here (4000 inputs per
 //! parser, fixed seed); the long run of ≥ 1,000,000 per parser is
-//! `cargo run --release --example fuzz_parsers`, recorded in results/fuzz.
+//! `cargo run --profile fuzz --example fuzz_parsers` (overflow checks on),
+//! recorded in results/fuzz.
 
 mod common;
 
@@ -31,4 +32,17 @@ fn no_parser_panics_or_hangs_on_mutated_input() {
     }
     let _ = std::panic::take_hook();
     eprintln!("{}", report.join("\n"));
+}
+
+#[test]
+fn every_parser_is_fuzzed_once() {
+    let names: Vec<&str> = targets().iter().map(|t| t.name).collect();
+    let mut unique = names.clone();
+    unique.sort_unstable();
+    unique.dedup();
+    assert_eq!(
+        unique.len(),
+        names.len(),
+        "a target listed twice: {names:?}"
+    );
 }

@@ -4,13 +4,13 @@
 
 use varspec::PointSet;
 use varspec::integrands;
+use varspec::neighbours::closest_pair_ratio;
 use varspec::optimize::projections::{ProjectionObjective, parse_projections};
 use varspec::optimize::shear::Sheared;
 use varspec::optimize::{AdamOptions, Domain, PointObjective, adam};
 use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::samplers::Sampler;
-use varspec::square::design::closest_pair_ratio;
 use varspec::variance::{VarianceError, empirical_shifting, spatial_variance};
 
 /// Two-sided z for a per-check false-alarm rate of 1e-4.

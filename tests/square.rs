@@ -6,12 +6,11 @@
 //! saw.
 
 use varspec::PointSet;
+use varspec::neighbours::closest_pair_ratio;
 use varspec::optimize::AdamOptions;
 use varspec::registry;
 use varspec::rng::{set_rng, uniform};
-use varspec::square::design::{
-    SquareTerm, closest_pair_ratio, default_options, design, parse_target,
-};
+use varspec::square::design::{SquareTerm, default_options, design, parse_target};
 use varspec::square::halfplanes::{
     Projection, directional_loss, directions, halfplane_mse, pair_form,
 };

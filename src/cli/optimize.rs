@@ -6,23 +6,17 @@ use std::time::Instant;
 
 use anyhow::bail;
 use clap::Subcommand;
-use rayon::prelude::*;
 use serde_json::json;
 
 use super::{args, progress};
-use varspec::baseline::classic_baselines;
+use varspec::design::torus::{TorusPlan, TorusRequest, results_bytes};
 use varspec::io::write_atomic;
 use varspec::optimize::adapted::{
-    CheckpointEvent, CheckpointPlan, Kept, checkpoint_path, design_sets, remove_checkpoints,
+    CheckpointEvent, CheckpointPlan, checkpoint_path, remove_checkpoints,
 };
-use varspec::optimize::lattice::best_lattice;
-use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers;
-use varspec::samplers::SamplerError;
 use varspec::spectrum::Upsampling;
-use varspec::spectrum::nufft::nufft_memory_bytes;
 
 #[derive(Subcommand)]
 pub enum OptimizeCommand {
@@ -179,13 +173,6 @@ enum DomainArg {
     Square,
 }
 
-/// Bytes of the designed sets kept until all are written: each set's
-/// points and its loss curve (loss and time per iteration, at most 2000).
-fn results_bytes(a: &PointsArgs) -> f64 {
-    let iters = a.iters.unwrap_or(2000) as f64;
-    a.sets as f64 * (a.n as f64 * a.dim as f64 * 8.0 + iters * 16.0)
-}
-
 fn points(a: PointsArgs) -> anyhow::Result<()> {
     args::check_outputs([
         Some(a.output.as_path()),
@@ -198,7 +185,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     }
     varspec::memory::check(
         &format!("the results of {} designed sets of {} points", a.sets, a.n),
-        Some(results_bytes(&a)),
+        Some(results_bytes(a.sets, a.n, a.dim, a.iters)),
         "lower --sets",
     )?;
     if !(a.checkpoint_every >= 0.0 && a.checkpoint_every.is_finite()) {
@@ -258,65 +245,25 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     if projections {
         return points_projections(a);
     }
-    let target = Target::parse(&a.target)?;
-    // 2D integrand targets start from the integration lattice with the
-    // smallest exact variance (measured: 0.14x CMJ on a half-plane at
-    // N = 256 against 0.29x from CMJ; results/optimize-adapted).
-    let integrand = match &target {
-        Target::Integrand(spec) => Some(varspec::integrands::parse(spec)?),
-        _ => None,
-    };
-    let exact_form = integrand.as_ref().filter(|f| f.has_autocov());
-    let init_name = a.init.clone().unwrap_or_else(|| {
-        match &exact_form {
-            Some(f) if a.dim == 2 && f.dim() == 2 => "lattice",
-            _ if integrand.is_some() && a.dim == 2 => "cmj",
-            _ => "random",
-        }
-        .into()
-    });
-    let iters = a.iters.unwrap_or(1000);
-    let mut options = DescentOptions::for_target(a.n, a.dim, &target);
-    options.iters = iters;
-    if let Some(t) = a.tol {
-        options.tolerance = t;
-    }
-    if let Some(r) = a.rel_tol {
-        options.rel_tol = r;
-    }
-    options.upsampling = match a.upsampling {
-        UpsamplingArg::Auto => options.upsampling,
-        UpsamplingArg::Two => Upsampling::Two,
-        UpsamplingArg::FiveFourths => Upsampling::FiveFourths,
-    };
-    if let Some(res) = a.res {
-        if res < 3 {
-            bail!("--res must be at least 3 (the box |k| < K/2 must hold a frequency besides 0)");
-        }
-        options.half = (res - 1) / 2;
-    }
-    if a.coarse {
-        if a.dim != 2 || matches!(target, Target::Integrand(_)) {
-            bail!(
-                "--coarse applies to 2D blue-noise targets (family:, power:, radial:), not to integrand targets or other dimensions"
-            );
-        }
-        options.coarse_half = Some(options.half / 4);
-    }
-    let coarse_half = options.coarse_half;
-    let half = options.half;
-    let options_tolerance = options.tolerance;
-    let options_rel_tol = options.rel_tol;
-    let optimizer = PointOptimizer::new(a.dim, &target, options)?;
-    let start = Instant::now();
-    let (init, lattice): (Box<dyn samplers::Sampler>, _) = if init_name == "lattice" {
-        let Some(f) = exact_form.filter(|f| f.dim() == 2 && a.dim == 2) else {
-            bail!(
-                "--init lattice needs a 2D integrand target with a closed-form autocovariance \
-                 (cos, disk, box, gaussian, halfplane)"
-            );
-        };
-        let found = best_lattice(a.n, f.as_ref())?;
+    let plan = TorusPlan::new(TorusRequest {
+        n: a.n,
+        dim: a.dim,
+        target: a.target.clone(),
+        sets: a.sets,
+        iters: a.iters,
+        seed: a.seed,
+        init: a.init.clone(),
+        tol: a.tol,
+        rel_tol: a.rel_tol,
+        upsampling: match a.upsampling {
+            UpsamplingArg::Auto => None,
+            UpsamplingArg::Two => Some(Upsampling::Two),
+            UpsamplingArg::FiveFourths => Some(Upsampling::FiveFourths),
+        },
+        res: a.res,
+        coarse: a.coarse,
+    })?;
+    if let Some(found) = plan.lattice() {
         println!(
             "start: the best of {} integration lattices of {} points (dual basis ({}, 0), ({}, {})), exact variance {:.4e}",
             found.candidates,
@@ -332,47 +279,17 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
                 found.rounding_bound
             );
         }
-        (Box::new(found.lattice), Some(found))
-    } else {
-        (registry::build(&init_name, a.n, Some(a.dim), &[])?, None)
-    };
-    let plan_bytes = nufft_memory_bytes(optimizer.frequencies()).unwrap_or(f64::INFINITY);
-    // An upper bound: the plans (the coarse phase's too, about a sixteenth
-    // of the box), each running descent, the kept results, and the classic
-    // samplers' sets of the comparison (measured at N = 1,048,576 with
-    // --coarse: peak 525 MiB against 661 MiB stated).
-    let coarse_bytes = if a.coarse { plan_bytes / 16.0 } else { 0.0 };
-    let baseline_bytes = a.sets.max(8) as f64 * a.n as f64 * a.dim as f64 * 8.0;
-    let memory = plan_bytes
-        + coarse_bytes
-        + rayon::current_num_threads().min(a.sets) as f64 * optimizer.descent_bytes(a.n)
-        + results_bytes(&a)
-        + baseline_bytes;
-    varspec::memory::check(
-        &format!(
-            "{} descent(s) of {} points on a box |k| <= {half}",
-            a.sets, a.n
-        ),
-        Some(memory),
-        "lower --sets, -n or --res",
-    )?;
+    }
+    let frequencies = plan.optimizer().frequencies();
     println!(
-        "memory: about {:.0} MiB (box |k| <= {half}: {} frequencies; {} set(s) at a time)",
-        memory / (1024.0 * 1024.0),
-        optimizer.frequencies().len(),
+        "memory: about {:.0} MiB (box |k| <= {}: {} frequencies; {} set(s) at a time)",
+        plan.memory_bytes() / (1024.0 * 1024.0),
+        frequencies.half,
+        frequencies.len(),
         rayon::current_num_threads().min(a.sets)
     );
-    let bar = progress::bar((a.sets * iters) as u64, "optimizing");
-    let run = format!(
-        "optimize points -n {} -d {} --target {} --init {init_name} --seed {} --iters {iters} --res {} --tol {options_tolerance:e} --rel-tol {options_rel_tol:e} --upsampling {} --coarse {}",
-        a.n,
-        a.dim,
-        a.target,
-        a.seed,
-        2 * half + 1,
-        optimizer.upsampling(),
-        a.coarse,
-    );
+    let bar = progress::bar((a.sets * plan.iters()) as u64, "optimizing");
+    let run = plan.run_line();
     let on_event = |event: CheckpointEvent| match event {
         CheckpointEvent::Resumed {
             set,
@@ -400,106 +317,62 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         every: std::time::Duration::from_secs_f64(a.checkpoint_every),
         on_event: &on_event,
     });
-    let results = design_sets(
-        &optimizer,
-        init.as_ref(),
-        exact_form.map(|f| f.as_ref()),
-        a.seed,
-        a.sets,
-        &|_, _| bar.inc(1),
-        checkpoint.as_ref(),
-    )?;
+    let design = plan.run(&|_, _| bar.inc(1), checkpoint.as_ref())?;
     bar.finish_and_clear();
-    let seconds = start.elapsed().as_secs_f64();
-    let sets: Vec<_> = results.iter().map(|r| r.points.clone()).collect();
-    varspec::io::write_point_file(&a.output, &sets)?;
+    varspec::io::write_point_file(&a.output, &design.points)?;
     if let Some(path) = &a.checkpoint {
         for (file, e) in remove_checkpoints(path, a.sets) {
             eprintln!("warning: checkpoint {} not removed: {e}", file.display());
         }
     }
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    let final_losses: Vec<f64> = results
-        .iter()
-        .map(|r| {
-            r.descent
-                .losses
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min)
-        })
-        .collect();
-    let mut comparison = serde_json::Map::new();
-    comparison.insert(
-        "optimized".into(),
-        json!({"n": a.n, "loss": mean(&final_losses)}),
-    );
-    let baselines = classic_baselines(a.n, a.dim, a.sets.max(8), a.seed, |sets| {
-        let losses: Vec<f64> = sets.par_iter().map(|p| optimizer.loss(p)).collect();
-        Ok::<_, SamplerError>(mean(&losses))
-    })?;
-    for b in &baselines {
-        comparison.insert(b.name.into(), json!({"n": b.n, "loss": b.score}));
-    }
-    let iterations: Vec<usize> = results.iter().map(|r| r.descent.losses.len()).collect();
-    // The exact variance (spatial form, no box) beside the in-box loss, for
-    // integrand targets that have a closed-form autocovariance.
-    let exact: Option<Vec<f64>> = results.iter().map(Kept::variance).collect();
-    let kept_start = results.iter().filter(|r| r.start_returned()).count();
-    let coarse = match (results[0].descent.coarse_iterations, coarse_half) {
+    let coarse = match (design.coarse_iterations[0], plan.coarse_half()) {
         (c, Some(h)) if c > 0 => format!("{c} on the box |k| <= {h} then "),
         _ => String::new(),
     };
     println!(
-        "{} set(s) of {} points for {} in {seconds:.2} s ({coarse}{} iterations for set 0); loss {:.4e}",
-        a.sets,
-        a.n,
-        a.target,
-        iterations[0],
-        mean(&final_losses)
+        "{} set(s) of {} points for {} in {:.2} s ({coarse}{} iterations for set 0); loss {:.4e}",
+        a.sets, a.n, a.target, design.seconds, design.iterations[0], design.mean_loss
     );
-    let rounding = results
-        .iter()
-        .filter_map(|r| r.exact.map(|e| e.rounding))
-        .fold(0.0, f64::max);
-    if let Some(v) = exact.as_deref().map(mean) {
-        if v <= rounding {
+    if let Some(v) = design.exact_variance {
+        if v <= design.rounding {
             println!(
-                "  exact variance (spatial form, no box) {v:.4e}: at the form's rounding floor ({rounding:.1e}); the in-box loss resolves it"
+                "  exact variance (spatial form, no box) {v:.4e}: at the form's rounding floor ({:.1e}); the in-box loss resolves it",
+                design.rounding
             );
         } else {
             println!(
                 "  exact variance (spatial form, no box) {v:.4e}: {:.0}% of it lies beyond the box",
-                100.0 * (1.0 - mean(&final_losses) / v).max(0.0)
+                100.0 * (1.0 - design.mean_loss / v).max(0.0)
             );
         }
     }
-    if kept_start > 0 {
+    if design.kept_start > 0 {
         println!(
-            "  {kept_start} of {} set(s): the descent did not lower the {}, so the start ({init_name}) is returned unchanged",
+            "  {} of {} set(s): the descent did not lower the {}, so the start ({}) is returned unchanged",
+            design.kept_start,
             a.sets,
-            if exact.is_some() {
+            if design.exact_variance.is_some() {
                 "exact variance"
             } else {
                 "loss"
-            }
+            },
+            design.init
         );
     }
-    for (name, v) in &comparison {
+    for (name, v) in &design.comparison {
         println!(
             "  {name:<14} loss {:.4e}",
             v["loss"].as_f64().unwrap_or(f64::NAN)
         );
     }
-    let curve: Vec<(f64, f64)> = results[0]
-        .descent
-        .seconds
+    let curve: Vec<(f64, f64)> = design
+        .loss_curve_seconds
         .iter()
         .copied()
-        .zip(results[0].descent.losses.iter().copied())
+        .zip(design.loss_curve.iter().copied())
         .collect();
     if let Some(path) = &a.curve {
-        write_loss_curve(path, curve.iter().map(|&(t, l)| (t, l)))?;
+        write_loss_curve(path, curve.iter().copied())?;
     }
     if let Some(path) = &a.curve_png {
         use varspec::report::plot::{LinePlot, Series, line_plot_png};
@@ -516,7 +389,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
             points: curve.clone(),
             reference: false,
         }];
-        for b in &baselines {
+        for b in &design.baselines {
             series.push(Series {
                 label: b.name.into(),
                 points: vec![(t0, b.score), (t1, b.score)],
@@ -533,18 +406,8 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         line_plot_png(&plot, path)?;
     }
     if let Some(path) = &a.report {
-        let report = json!({
-            "target": a.target, "n": a.n, "dim": a.dim, "sets": a.sets, "seed": a.seed, "init": init_name, "domain": "torus",
-            "half": half, "res": 2 * half + 1, "tolerance": options_tolerance, "upsampling": optimizer.upsampling(), "seconds": seconds, "iterations": iterations,
-            "coarse_iterations": results.iter().map(|r| r.descent.coarse_iterations).collect::<Vec<_>>(),
-            "loss": "sum over 0 < |k|inf <= half of W(k) P_S(k)  (for an integrand target: its predicted variance within the box)",
-            "loss_curve": results[0].descent.losses, "loss_curve_seconds": results[0].descent.seconds, "comparison": comparison,
-            "exact_variance": exact.as_deref().map(mean),
-            "exact": results.iter().map(|r| r.exact.map(|e| json!({"start": e.start, "descended": e.descended, "rounding_bound": e.rounding, "kept_start": e.kept_start}))).collect::<Vec<_>>(),
-            "lattice": lattice,
-        });
         write_atomic(path, |w| {
-            w.write_all(serde_json::to_string_pretty(&report)?.as_bytes())
+            w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
         })?;
     }
     Ok(())
@@ -553,75 +416,42 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
 /// `optimize points -d 4` with targets per projection: one 4D descent on
 /// the planes' spectral losses, from umj by default.
 fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
-    use varspec::optimize::projections::{ProjectionObjective, parse_projections};
-    use varspec::optimize::{AdamOptions, Domain, adam};
-    use varspec::square::design::closest_pair_ratio;
-
-    let terms = parse_projections(&a.target, a.n)?;
-    let init_name = a.init.clone().unwrap_or_else(|| "umj".into());
-    let init = registry::build(&init_name, a.n, Some(4), &[])?;
-    let options = AdamOptions {
-        iters: a.iters.unwrap_or(1000),
-        rel_tol: a.rel_tol.unwrap_or(1e-4),
-        step: 0.05,
-        final_step: 0.002,
-        score_every: 1,
-        floor: 0.0,
+    use varspec::design::projections::{ProjectionRequest, design_projections};
+    let request = ProjectionRequest {
+        n: a.n,
+        target: a.target.clone(),
+        sets: a.sets,
+        iters: a.iters,
+        rel_tol: a.rel_tol,
+        seed: a.seed,
+        init: a.init.clone(),
     };
-    let bar = progress::bar((a.sets * options.iters) as u64, "optimizing");
-    let start = Instant::now();
-    let results = (0..a.sets)
-        .into_par_iter()
-        .map(|r| -> anyhow::Result<_> {
-            let first = init.sample(&mut set_rng(a.seed, r as u64))?;
-            let objective = ProjectionObjective::new(&terms, &first);
-            let before: Vec<f64> = terms.iter().map(|t| t.loss(&first)).collect();
-            let result = adam(first, &objective, &options, Domain::Torus, &|_, _| {
-                bar.inc(1)
-            });
-            Ok((before, result))
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
+    let bar = progress::bar((a.sets * a.iters.unwrap_or(1000)) as u64, "optimizing");
+    let design = design_projections(&request, &|_, _| bar.inc(1))?;
     bar.finish_and_clear();
-    let seconds = start.elapsed().as_secs_f64();
-    let sets: Vec<_> = results.iter().map(|r| r.1.points.clone()).collect();
-    varspec::io::write_point_file(&a.output, &sets)?;
-    let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
-    let mut per_term = Vec::new();
+    varspec::io::write_point_file(&a.output, &design.points)?;
     println!(
-        "{} set(s) of {} 4D points optimized for {} projection term(s) in {seconds:.2} s (from {init_name})",
+        "{} set(s) of {} 4D points optimized for {} projection term(s) in {:.2} s (from {})",
         a.sets,
         a.n,
-        terms.len()
+        design.terms.len(),
+        design.seconds,
+        design.init
     );
-    for (t, term) in terms.iter().enumerate() {
-        let before = mean(results.iter().map(|r| r.0[t]).collect());
-        let after = mean(sets.iter().map(|s| term.loss(s)).collect());
-        println!("  {:<40} loss {before:.4e} -> {after:.4e}", term.label);
-        per_term.push(
-            json!({"term": term.label, "weight": term.weight, "rows": term.rows,
-                             "loss_before": before, "loss_after": after}),
+    for t in &design.terms {
+        println!(
+            "  {:<40} loss {:.4e} -> {:.4e}",
+            t.term, t.loss_before, t.loss_after
         );
     }
-    let closest = |dims: [usize; 2]| -> anyhow::Result<f64> {
-        let mut worst = f64::INFINITY;
-        for s in &sets {
-            worst = worst.min(closest_pair_ratio(&s.projected(&dims)?));
-        }
-        Ok(worst)
-    };
-    let (xy, uv) = (closest([0, 1])?, closest([2, 3])?);
-    println!("  closest pair / hexagonal spacing: XY {xy:.3}, UV {uv:.3}");
+    let closest = design.closest_pair_over_hexagonal;
+    println!(
+        "  closest pair / hexagonal spacing: XY {:.3}, UV {:.3}",
+        closest.xy, closest.uv
+    );
     if let Some(path) = &a.report {
-        let report = json!({
-            "domain": "torus", "target": a.target, "n": a.n, "dim": 4, "sets": a.sets, "seed": a.seed,
-            "init": init_name, "iterations": options.iters, "seconds": seconds, "terms": per_term,
-            "closest_pair_over_hexagonal": {"xy": xy, "uv": uv},
-            "loss": "sum of w_t L_t(M_t X) / L_t(M_t X0) over the projection terms",
-            "loss_curve": results[0].1.losses, "loss_curve_seconds": results[0].1.seconds,
-        });
         write_atomic(path, |w| {
-            w.write_all(serde_json::to_string_pretty(&report)?.as_bytes())
+            w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
         })?;
     }
     Ok(())
@@ -631,90 +461,38 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
 /// unshifted estimator, then score the result and the classic samplers on
 /// family members the descent never saw.
 fn points_square(a: PointsArgs) -> anyhow::Result<()> {
-    use varspec::square::design::{
-        TermKind, closest_pair_ratio, default_options, design, parse_target,
-    };
-    use varspec::square::{Family, family_mse};
-
+    use varspec::design::square::{SquareRequest, design_on_square};
     if a.dim != 2 {
         bail!("the square holds 2D point sets (got -d {})", a.dim);
     }
-    let terms = parse_target(&a.target)?;
-    // Scores: the designed sets and 8 or more sets of each classic sampler.
-    varspec::square::mse::check_family_memory(a.members, a.sets.max(8))?;
-    let mut options = default_options();
-    if let Some(i) = a.iters {
-        options.iters = i;
-    }
-    let init_name = a.init.clone().unwrap_or_else(|| "jitter".into());
-    let (init, n) = registry::build_nearest(&init_name, a.n, Some(2), &[])?;
-    if n != a.n {
-        bail!(
-            "--init {init_name} cannot start from N = {} (nearest: {n}); pick another --init or N",
-            a.n
-        );
-    }
-    let bar = progress::bar((a.sets * options.iters) as u64, "optimizing");
-    let start = Instant::now();
-    let results = (0..a.sets)
-        .into_par_iter()
-        .map(|r| -> anyhow::Result<_> {
-            let first = init.sample(&mut set_rng(a.seed, r as u64))?;
-            let seed = varspec::rng::mix64(a.seed ^ (r as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-            Ok(design(&terms, first, seed, &options, &|_, _| bar.inc(1)))
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    bar.finish_and_clear();
-    let seconds = start.elapsed().as_secs_f64();
-    let sets: Vec<_> = results.iter().map(|r| r.points.clone()).collect();
-    varspec::io::write_point_file(&a.output, &sets)?;
-    // Scores on members drawn with --score-seed.
-    // The peer's two families, and the target's own.
-    let mut families = vec![Family::parse("halfplanes")?, Family::parse("gaussians")?];
-    for term in &terms {
-        if let TermKind::Family(f) = &term.kind {
-            if !families.iter().any(|g| g.spec() == f.spec()) {
-                families.push(f.clone());
-            }
-        }
-    }
-    let score = |sets: &[varspec::PointSet]| {
-        let mut m = serde_json::Map::new();
-        for f in &families {
-            let s = family_mse(sets, f, a.members, a.score_seed);
-            m.insert(
-                f.spec(),
-                json!({"mse": s.mse, "stderr": s.stderr, "members": s.members}),
-            );
-        }
-        let closest = sets
-            .iter()
-            .map(closest_pair_ratio)
-            .fold(f64::INFINITY, f64::min);
-        m.insert("closest_pair_over_hexagonal".into(), json!(closest));
-        m
+    let request = SquareRequest {
+        n: a.n,
+        target: a.target.clone(),
+        sets: a.sets,
+        iters: a.iters,
+        seed: a.seed,
+        init: a.init.clone(),
+        members: a.members,
+        score_seed: a.score_seed,
     };
-    let mut comparison = serde_json::Map::new();
-    comparison.insert("optimized".into(), json!(score(&sets)));
-    for b in classic_baselines(a.n, 2, a.sets.max(8), a.seed, |sets| {
-        Ok::<_, SamplerError>(score(sets))
-    })? {
-        let mut m = b.score;
-        m.insert("n".into(), json!(b.n));
-        comparison.insert(b.name.into(), json!(m));
-    }
+    let iters = a
+        .iters
+        .unwrap_or(varspec::square::design::default_options().iters);
+    let bar = progress::bar((a.sets * iters) as u64, "optimizing");
+    let design = design_on_square(&request, &|_, _| bar.inc(1))?;
+    bar.finish_and_clear();
+    varspec::io::write_point_file(&a.output, &design.points)?;
     println!(
-        "{} set(s) of {} points designed on the square for {} in {seconds:.2} s (from {init_name}); \
+        "{} set(s) of {} points designed on the square for {} in {:.2} s (from {}); \
          unshifted estimator, scored on {} members per family (seed {})",
-        a.sets, a.n, a.target, a.members, a.score_seed
+        a.sets, a.n, a.target, design.seconds, design.init, a.members, a.score_seed
     );
-    for (name, v) in &comparison {
+    for (name, v) in &design.comparison {
         print!("  {name:<14}");
-        for f in &families {
+        for f in &design.families {
             print!(
-                "  {} {:.3e}",
-                f.spec(),
-                v[f.spec()]["mse"].as_f64().unwrap_or(f64::NAN)
+                "  {f} {:.3e}",
+                v[f.as_str()]["mse"].as_f64().unwrap_or(f64::NAN)
             );
         }
         println!(
@@ -727,26 +505,16 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     if let Some(path) = &a.curve {
         write_loss_curve(
             path,
-            results[0]
-                .seconds
+            design
+                .loss_curve_seconds
                 .iter()
                 .copied()
-                .zip(results[0].losses.iter().copied()),
+                .zip(design.loss_curve.iter().copied()),
         )?;
     }
     if let Some(path) = &a.report {
-        let report = json!({
-            "domain": "square", "estimator": "unshifted: mean of f over the set on [0,1)^2",
-            "target": a.target, "n": a.n, "sets": a.sets, "seed": a.seed, "init": init_name,
-            "iterations": options.iters, "seconds": seconds,
-            "loss": "sum of w_t MSE_t / MSE_t(start) (blue: repulsion / its value for uniform points); stochastic per iteration",
-            "score_start": results.iter().map(|r| r.start_score).collect::<Vec<_>>(),
-            "score_best": results.iter().map(|r| r.best_score).collect::<Vec<_>>(),
-            "loss_curve": results[0].losses, "loss_curve_seconds": results[0].seconds,
-            "comparison": comparison, "score_members": a.members, "score_seed": a.score_seed,
-        });
         write_atomic(path, |w| {
-            w.write_all(serde_json::to_string_pretty(&report)?.as_bytes())
+            w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
         })?;
     }
     Ok(())
@@ -916,12 +684,8 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
 
 fn shear(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::integrands;
-    use varspec::optimize::shear::{
-        MAX_SHEAR_RANGE, ObjectiveOptions, SENSITIVITY_STEP, ShearObjective, Sheared, search_shear,
-        shear_set, spectral_start,
-    };
-    use varspec::samplers::Sampler;
-    use varspec::variance::{VarianceError, empirical_shifting};
+    use varspec::optimize::shear::checked::search_and_check;
+    use varspec::optimize::shear::shear_set;
     // The pictures --png-prefix names (a pixel also gets its light field's).
     let pictures: Vec<std::path::PathBuf> = a
         .png_prefix
@@ -945,20 +709,6 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     }
 
     let f = integrands::parse(&a.integrand)?;
-    if f.dim() != 4 {
-        bail!(
-            "the shear search needs a 4D integrand (e.g. defocus:...), {} is {}D",
-            f.spec(),
-            f.dim()
-        );
-    }
-    if a.realizations == 1 || !(a.range.is_finite() && a.range > 0.0 && a.range <= MAX_SHEAR_RANGE)
-    {
-        bail!(
-            "--realizations must be 0 (no check) or at least 2, and --range a positive number up to {MAX_SHEAR_RANGE} (got {:?})",
-            a.range
-        );
-    }
     let sampler = registry::build(&a.sampler, a.n, Some(4), &[])?;
     // The written sets, drawn and sheared (two copies), and a few numbers
     // per realization of the check.
@@ -972,69 +722,20 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         Some(bytes),
         "lower --sets or --realizations",
     )?;
-    let start = Instant::now();
-    let spectral = spectral_start(f.as_ref(), 64, a.range);
-    let mut starts = spectral.candidates();
-    starts.push([0.0, 0.0]);
-    let options = ObjectiveOptions {
-        seed: a.seed,
-        ..ObjectiveOptions::default()
-    };
-    let objective = ShearObjective::new(f.as_ref(), sampler.as_ref(), &starts, options)?;
-    let found = search_shear(&objective, &spectral, a.range)?;
-    let search_seconds = start.elapsed().as_secs_f64();
-    // An independent check on fresh realizations: the same estimator, by
-    // evaluating f (no spectra).
-    let eval_seed = a.seed ^ 0x0e7a_1000;
-    let estimate = |shear: [f64; 2]| -> anyhow::Result<_> {
-        let sheared = Sheared::new(sampler.as_ref(), shear)?;
-        Ok(empirical_shifting(
-            f.as_ref(),
-            a.realizations,
-            a.seed ^ 1,
-            &[0, 1],
-            |r| -> Result<_, VarianceError> {
-                Ok(sheared.sample(&mut set_rng(eval_seed, r as u64))?)
-            },
-        )?)
-    };
-    let check = if a.realizations >= 2 {
-        Some((estimate([0.0, 0.0])?, estimate(found.shear)?))
-    } else {
-        None
-    };
+    let run = search_and_check(
+        f.as_ref(),
+        sampler.as_ref(),
+        &a.sampler,
+        a.seed,
+        a.range,
+        a.realizations,
+    )?;
+    let (found, check, search_seconds) = (&run.found, &run.check, run.search_seconds);
     sheared_outputs(&a, &f.spec(), sampler.as_ref(), |s| {
         Ok(shear_set(s, found.shear)?)
     })?;
-    let analytic = f.light_field().map(|l| l.layer_shears());
-    let relative_stderr = found.optimum.stderr / found.optimum.value;
-    let plane = |p: &varspec::optimize::shear::PlaneDirections| {
-        json!({"principal_slope": p.principal, "eigenvalue_ratio": p.eigenvalue_ratio,
-               "line_slopes": p.lines, "first_line_share": p.first_line_share,
-               "second_line_share": p.second_line_share, "one_line_misfit": p.one_line_misfit})
-    };
-    let ci = |e: &varspec::variance::EmpiricalEstimate| json!({"variance": e.variance, "stderr": e.stderr, "ci_low": e.ci_low, "ci_high": e.ci_high, "realizations": e.realizations});
-    let d = SENSITIVITY_STEP;
-    let out = json!({
-        "sampler": a.sampler, "integrand": f.spec(), "n": a.n, "sets": a.sets, "seed": a.seed,
-        "shear": found.shear, "initial_shear": found.initial.0, "analytic_shear": analytic,
-        "double_wedge": spectral.double_wedge, "kept_unsheared": found.kept_unsheared,
-        "spectrum": {"xu": plane(&spectral.planes[0]), "yv": plane(&spectral.planes[1])},
-        "estimator": "(x,y)-shifted: mean of f(x'+sx, y'+sy, u, v) over the sheared set, s uniform in (x,y); unbiased for any shear",
-        "objective": {
-            "description": "expected variance of the estimator over the sampler's randomness (closed form where the halves have one)",
-            "unsheared": found.unsheared.value, "initial": found.initial.1, "optimum": found.optimum.value,
-            "stderr": relative_stderr, "truncation_bound": objective.truncation_bound() / found.optimum.value,
-            "evaluations": found.evaluations, "terms": objective.terms(), "half": objective.half(),
-            "realizations": objective.realizations(),
-        },
-        "sensitivity": {"step": d, "a_minus": found.sensitivity[0], "a_plus": found.sensitivity[1],
-                        "b_minus": found.sensitivity[2], "b_plus": found.sensitivity[3]},
-        "variance_before": check.as_ref().map(|c| ci(&c.0)),
-        "variance_after": check.as_ref().map(|c| ci(&c.1)),
-        "reduction": found.unsheared.value / found.optimum.value,
-        "seconds": search_seconds,
-    });
+    let mut out = run.report.clone();
+    out["sets"] = json!(a.sets);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
@@ -1045,7 +746,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             found.shear[1],
             found.initial.0[0],
             found.initial.0[1],
-            if spectral.double_wedge {
+            if run.spectral.double_wedge {
                 "; double wedge"
             } else {
                 ""
@@ -1060,7 +761,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                 format!("{ratio:.2}x higher")
             }
         );
-        if let Some((before, after)) = &check {
+        if let Some((before, after)) = check {
             println!(
                 "check on {} fresh sets: {:.4e} [{:.4e}, {:.4e}] -> {:.4e} [{:.4e}, {:.4e}]",
                 after.realizations,

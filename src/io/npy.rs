@@ -165,13 +165,23 @@ fn read_header_checked(reader: &mut impl Read) -> Result<Vec<u8>, String> {
     {
         // Each dimension's magnitude, whatever signs a Python literal puts
         // before it (npyz reads `--5` as 5); a digit run beyond u64 counts
-        // as overflowing.
-        let magnitudes: Vec<Option<u64>> = dims
+        // as overflowing. Anything else (npyz would evaluate `a-b`, whose
+        // product it then overflows) is not a shape.
+        let items: Vec<&str> = dims
             .split(',')
             .map(|d| d.trim().trim_start_matches(['-', '+']))
-            .filter(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()))
-            .map(|d| d.parse::<u64>().ok())
+            .filter(|d| !d.is_empty())
             .collect();
+        if let Some(bad) = items
+            .iter()
+            .find(|d| !d.bytes().all(|b| b.is_ascii_digit()))
+        {
+            return Err(format!(
+                "the array's shape ({}) holds `{bad}`, not a whole number",
+                dims.trim()
+            ));
+        }
+        let magnitudes: Vec<Option<u64>> = items.iter().map(|d| d.parse::<u64>().ok()).collect();
         let product = magnitudes
             .iter()
             .try_fold(1u64, |a, d| d.and_then(|d| a.checked_mul(d)));

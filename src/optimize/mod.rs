@@ -50,6 +50,9 @@ pub enum OptimizeError {
     /// A checkpoint could not be resumed.
     #[error(transparent)]
     Checkpoint(#[from] checkpoint::CheckpointError),
+    /// The run needs more memory than the budget.
+    #[error(transparent)]
+    Memory(#[from] crate::memory::TooMuchMemory),
     /// argmin reported an error.
     #[error("shear search failed: {0}")]
     Search(String),

@@ -252,13 +252,3 @@ pub fn design(
     let objective = SquareObjective::new(terms.to_vec(), &start, seed);
     adam(start, &objective, options, Domain::Square, on_iteration)
 }
-
-/// The closest pair of `set` (toroidal distance) over the hexagonal
-/// spacing √(2/(√3 N)), the densest packing's.
-pub fn closest_pair_ratio(set: &PointSet) -> f64 {
-    let hex = (2.0 / (3f64.sqrt() * set.len().max(1) as f64)).sqrt();
-    crate::neighbours::nearest_neighbour_distances(set)
-        .into_iter()
-        .fold(f64::INFINITY, f64::min)
-        / hex
-}

@@ -13,6 +13,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::integrands;
+use crate::neighbours::closest_pair_ratio;
 use crate::optimize::shear::{
     ObjectiveOptions, ShearObjective, Sheared, search_shear, spectral_start,
 };
@@ -24,7 +25,7 @@ use crate::rng::set_rng;
 use crate::samplers::Sampler;
 use crate::spectrum::radial::radial_profile;
 use crate::spectrum::{FrequencyBox, Method, expected_power};
-use crate::square::design::{closest_pair_ratio, default_options, design, parse_target};
+use crate::square::design::{default_options, design, parse_target};
 use crate::square::{Family, family_mse};
 use crate::variance::{DEFAULT_SHIFT_SEED, VarianceError, empirical, fourier, spatial};
 

@@ -283,6 +283,8 @@ pub fn targets() -> Vec<Target> {
             seeds: lines(&[
                 "scene:dof,px=142,py=64",
                 "scene:shadows-disk,py=3,px=0",
+                "scene:shadows-square,px=0,py=255",
+                "scene:scenes/dof.json,px=10,py=20",
                 "scene:some/file.json,px=1,py=2",
             ]),
             run: Box::new(|b| varspec::scene::pixel::PixelIntegrand::parse_spec(&text(b)).is_ok()),
@@ -346,15 +348,6 @@ pub fn targets() -> Vec<Target> {
             run: Box::new(|b| {
                 varspec::scene::description::SceneFile::parse(&text(b), "fuzz.json").is_ok()
             }),
-        },
-        Target {
-            name: "scene pixel spec",
-            seeds: lines(&[
-                "scene:dof,px=33,py=1",
-                "scene:shadows-square,px=0,py=255",
-                "scene:scenes/dof.json,px=10,py=20",
-            ]),
-            run: Box::new(|b| varspec::scene::pixel::PixelIntegrand::parse_spec(&text(b)).is_ok()),
         },
         Target {
             name: "shard spec",

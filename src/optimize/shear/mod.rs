@@ -11,6 +11,7 @@
 //! jointly with Nelder–Mead (both from argmin). The result is never worse
 //! than no shear: if J(found) ≥ J(0, 0), the search returns (0, 0).
 
+pub mod checked;
 pub mod objective;
 pub mod start;
 
