@@ -535,29 +535,36 @@ fn the_main_job_writes_a_self_contained_report() {
             && spatial <= jitter["ci_high"].as_f64().unwrap(),
         "{jitter}"
     );
-    // The commands the page prints give its numbers: run them for CMJ.
-    let commands: Vec<&str> = report["predict"]["commands"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c.as_str().unwrap())
-        .collect();
-    let file = dir.join("cmj.csv");
-    let mut json = None;
-    for prefix in ["varspec sample cmj ", "varspec predict cmj.csv "] {
-        let line = commands.iter().find(|c| c.starts_with(prefix)).unwrap();
-        let mut args: Vec<&str> = line.split_whitespace().skip(1).collect();
-        for a in args.iter_mut().filter(|a| **a == "cmj.csv") {
-            *a = file.to_str().unwrap();
+    // The commands the page prints give its numbers: run them (file names
+    // moved into the test's folder, --json where the numbers are printed).
+    let run_printed = |section: &str, prefix: &str, json: bool| -> Vec<u8> {
+        let commands = report[section]["commands"].as_array().unwrap();
+        let line = commands
+            .iter()
+            .filter_map(|c| c.as_str())
+            .find(|c| c.starts_with(prefix))
+            .unwrap_or_else(|| panic!("{section}: no command `{prefix}…`"));
+        let mut args: Vec<String> = line
+            .split_whitespace()
+            .skip(1)
+            .map(|a| a.trim_matches('\'').to_string())
+            .collect();
+        for i in 0..args.len() {
+            let file = args[i].ends_with(".csv") || args[i].ends_with(".json");
+            if file || (i > 0 && args[i - 1] == "--png-prefix") {
+                args[i] = dir.join(&args[i]).to_str().unwrap().to_string();
+            }
         }
-        if prefix.contains("predict") {
-            args.push("--json");
+        if json && !args.iter().any(|a| a == "--json") {
+            args.push("--json".into());
         }
-        let run = varspec(&args);
+        let run = varspec(&args.iter().map(String::as_str).collect::<Vec<_>>());
         assert!(run.status.success(), "{line}: {run:?}");
-        json = Some(run.stdout);
-    }
-    let printed: serde_json::Value = serde_json::from_slice(&json.unwrap()).unwrap();
+        run.stdout
+    };
+    run_printed("predict", "varspec sample cmj ", false);
+    let printed: serde_json::Value =
+        serde_json::from_slice(&run_printed("predict", "varspec predict cmj.csv ", true)).unwrap();
     let cmj = &rows[2];
     assert_eq!(cmj["sampler"], "cmj");
     for (column, method) in [
@@ -571,6 +578,27 @@ fn the_main_job_writes_a_self_contained_report() {
             "the page's {column} column vs its printed predict command"
         );
     }
+    let shear: serde_json::Value =
+        serde_json::from_slice(&run_printed("shear", "varspec optimize shear ", true)).unwrap();
+    let page = &report["shear"];
+    for (column, value) in [
+        ("optimum", &shear["objective"]["optimum"]),
+        ("unsheared", &shear["objective"]["unsheared"]),
+        ("check_before", &shear["variance_before"]["variance"]),
+        ("check_after", &shear["variance_after"]["variance"]),
+    ] {
+        assert_eq!(page[column].as_f64(), value.as_f64(), "shear {column}");
+    }
+    run_printed("square", "varspec optimize points --domain square ", false);
+    let square: serde_json::Value =
+        serde_json::from_slice(&run_printed("square", "varspec predict --family ", true)).unwrap();
+    let designed = &report["square"]["rows"][0];
+    assert!(designed["name"].as_str().unwrap().starts_with("designed"));
+    assert_eq!(
+        designed["halfplanes"].as_f64(),
+        square["brute_force"]["mse"].as_f64(),
+        "the square section's design vs its printed commands"
+    );
     let scene = &report["scene"];
     assert!(scene["reduction"].as_f64().unwrap() > 1.5, "{scene}");
     assert!(

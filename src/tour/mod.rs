@@ -13,20 +13,15 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::integrands;
-use crate::neighbours::closest_pair_ratio;
-use crate::optimize::shear::{
-    ObjectiveOptions, ShearObjective, Sheared, search_shear, spectral_start,
-};
+use crate::optimize::shear::Sheared;
 use crate::points::PointSet;
 use crate::registry;
 use crate::report::plot::{LinePlot, Series, line_plot_png, spectrum_png};
 use crate::report::png::{render_points, save_png};
-use crate::rng::set_rng;
 use crate::samplers::Sampler;
 use crate::spectrum::radial::radial_profile;
 use crate::spectrum::{FrequencyBox, Method, expected_power};
-use crate::square::design::{default_options, design, parse_target};
-use crate::square::{Family, family_mse};
+use crate::square::Family;
 use crate::variance::{DEFAULT_SHIFT_SEED, VarianceError, empirical, fourier, spatial};
 
 /// What can stop the tour.
@@ -475,51 +470,49 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
 }
 
 fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
+    use crate::design::square::{SquareRequest, design_on_square};
     let n = 256;
     let target = "halfplanes+gaussians+16*blue";
-    let terms = parse_target(target).map_err(at("square target"))?;
-    let jitter = registry::build("jitter", n, Some(2), &[]).map_err(at("jitter"))?;
-    let count = 2;
-    let start = Instant::now();
-    let designed: Vec<PointSet> = draw(jitter.as_ref(), o.seed, count)?
-        .into_iter()
-        .enumerate()
-        .map(|(r, s)| {
-            design(
-                &terms,
-                s,
-                o.seed ^ (r as u64 + 1),
-                &default_options(),
-                &|_, _| {},
-            )
-            .points
+    let request = SquareRequest {
+        n,
+        target: target.into(),
+        sets: 2,
+        iters: None,
+        seed: o.seed,
+        init: None,
+        members: 1024,
+        score_seed: 1,
+    };
+    // As `optimize points --domain square` runs it, so the printed
+    // commands give these numbers.
+    let design = design_on_square(&request, &|_, _| {}).map_err(at("square design"))?;
+    let seconds_per_set = design.seconds / request.sets as f64;
+    let gaussians = Family::parse("gaussians").map_err(at("family"))?.spec();
+    let mse = |v: &serde_json::Value, family: &str| v[family]["mse"].as_f64().unwrap_or(f64::NAN);
+    // The design first, then the classic samplers.
+    let order = std::iter::once("optimized").chain(
+        design
+            .comparison
+            .keys()
+            .map(String::as_str)
+            .filter(|k| *k != "optimized"),
+    );
+    let mut rows: Vec<SquareRow> = order
+        .filter_map(|name| design.comparison.get(name).map(|v| (name.to_string(), v)))
+        .map(|(name, v)| SquareRow {
+            name: if name == "optimized" {
+                format!("designed ({target})")
+            } else {
+                name
+            },
+            halfplanes: mse(v, "halfplanes"),
+            gaussians: mse(v, &gaussians),
+            closest: v["closest_pair_over_hexagonal"]
+                .as_f64()
+                .unwrap_or(f64::NAN),
+            best: false,
         })
         .collect();
-    let seconds_per_set = start.elapsed().as_secs_f64() / count as f64;
-    let members = 1024;
-    let (halfplanes, gaussians) = (
-        Family::HalfPlanes,
-        Family::parse("gaussians").map_err(at("family"))?,
-    );
-    let score_seed = o.seed ^ 0x5c0e;
-    let mut rows = Vec::new();
-    let mut score = |name: String, sets: &[PointSet]| {
-        rows.push(SquareRow {
-            name,
-            halfplanes: family_mse(sets, &halfplanes, members, score_seed).mse,
-            gaussians: family_mse(sets, &gaussians, members, score_seed).mse,
-            closest: sets
-                .iter()
-                .map(closest_pair_ratio)
-                .fold(f64::INFINITY, f64::min),
-            best: false,
-        });
-    };
-    score(format!("designed ({target})"), &designed);
-    for name in ["jitter", "cmj", "sobol"] {
-        let s = registry::build(name, n, Some(2), &[]).map_err(at("a sampler"))?;
-        score(name.into(), &draw(s.as_ref(), o.seed ^ 7, 16)?);
-    }
     let best = rows
         .iter()
         .map(|r| r.halfplanes)
@@ -528,14 +521,14 @@ fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
         r.best = r.halfplanes == best;
     }
     let file = "square-design.png".to_string();
-    let img = render_points(&designed[0], [0, 1], 320).map_err(at("drawing points"))?;
+    let img = render_points(&design.points[0], [0, 1], 320).map_err(at("drawing points"))?;
     save_png(&img, &o.folder.join(&file)).map_err(at("writing a picture"))?;
     Ok(SquareSection {
         n,
         target: target.into(),
-        sets: count,
+        sets: request.sets,
         seconds_per_set,
-        members,
+        members: request.members,
         rows,
         pictures: vec![Figure {
             file,
@@ -543,9 +536,13 @@ fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
         }],
         commands: vec![
             format!(
-                "varspec optimize points --domain square -n {n} --target '{target}' --sets {count} -o sq.csv --report sq.json"
+                "varspec optimize points --domain square -n {n} --target '{target}' --sets {} --seed {} --score-seed {} -o sq.csv --report sq.json",
+                request.sets, request.seed, request.score_seed
             ),
-            "varspec predict --family halfplanes sq.csv".into(),
+            format!(
+                "varspec predict --family halfplanes sq.csv --members {} --seed {}",
+                request.members, request.score_seed
+            ),
         ],
     })
 }
@@ -558,26 +555,26 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
         .map(|l| l.layer_shears()[0][0])
         .ok_or_else(|| at("the pixel")("not a light field"))?;
     let umj = registry::build("umj", n, Some(4), &[]).map_err(at("umj"))?;
-    let start = Instant::now();
-    let spectral = spectral_start(f.as_ref(), 64, 2.0);
-    let mut starts = spectral.candidates();
-    starts.push([0.0, 0.0]);
-    let options = ObjectiveOptions {
-        seed: o.seed,
-        ..ObjectiveOptions::default()
-    };
-    let objective = ShearObjective::new(f.as_ref(), umj.as_ref(), &starts, options)
-        .map_err(at("shear objective"))?;
-    let found = search_shear(&objective, &spectral, 2.0).map_err(at("shear search"))?;
-    let seconds = start.elapsed().as_secs_f64();
-    let check = |shear: [f64; 2]| {
-        let sheared = Sheared::new(umj.as_ref(), shear).map_err(at("shearing"))?;
-        crate::variance::empirical_shifting(f.as_ref(), 4000, o.seed ^ 1, &[0, 1], |r| {
-            Ok::<_, VarianceError>(sheared.sample(&mut set_rng(o.seed ^ 0x0e7a, r as u64))?)
-        })
-        .map_err(at("shear check"))
-    };
-    let (before, after) = (check([0.0, 0.0])?, check(found.shear)?);
+    // The search and its check as `optimize shear` runs them (defaults:
+    // range 2, 4000 check realizations), so the printed command gives
+    // these numbers.
+    let run = crate::optimize::shear::checked::search_and_check(
+        f.as_ref(),
+        umj.as_ref(),
+        "umj",
+        o.seed,
+        2.0,
+        4000,
+    )
+    .map_err(at("shear search"))?;
+    let (found, seconds) = (&run.found, run.search_seconds);
+    let (before, after) = run
+        .check
+        .clone()
+        .ok_or_else(|| at("shear check")("no check was run"))?;
+    let truncation_bound = run.report["objective"]["truncation_bound"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
     let mut spectra = Vec::new();
     let freqs = FrequencyBox::from_resolution(2, 64);
     for (label, shear) in [("before", [0.0, 0.0]), ("after", found.shear)] {
@@ -621,7 +618,7 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
         analytic,
         unsheared: found.unsheared.value,
         optimum: found.optimum.value,
-        truncation_bound: objective.truncation_bound() / found.optimum.value,
+        truncation_bound,
         reduction: found.unsheared.value / found.optimum.value,
         check_before: before.variance,
         check_before_low: before.ci_low,
@@ -632,8 +629,8 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
         seconds,
         spectra,
         commands: vec![format!(
-            "varspec optimize shear -n {n} --integrand {} --png-prefix shear --json",
-            o.pixel
+            "varspec optimize shear -n {n} --integrand {} --seed {} --png-prefix shear --json",
+            o.pixel, o.seed
         )],
     })
 }
