@@ -939,6 +939,13 @@ fn a_closed_standard_output_is_not_an_error() {
     assert!(!err.contains("panicked"), "{err}");
 }
 
+/// A CSV file's header and records, read by the csv crate.
+fn csv_table(path: &std::path::Path) -> (Vec<String>, Vec<csv::StringRecord>) {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header = r.headers().unwrap().iter().map(str::to_string).collect();
+    (header, r.records().map(|x| x.unwrap()).collect())
+}
+
 /// `bench render` and `bench predict` write CSV through serde records that
 /// the csv crate reads back: the header names the columns, both BVHs find
 /// the same hits, and the spatial row is the exact reference of its group.
@@ -958,9 +965,9 @@ fn bench_tables_are_csv_with_named_columns() {
         Some("2"),
     );
     assert!(run.status.success(), "{run:?}");
-    let mut r = csv::Reader::from_path(&render).unwrap();
+    let (header, rows) = csv_table(&render);
     assert_eq!(
-        r.headers().unwrap().iter().collect::<Vec<_>>(),
+        header,
         [
             "bvh",
             "triangles",
@@ -971,7 +978,6 @@ fn bench_tables_are_csv_with_named_columns() {
             "hits"
         ]
     );
-    let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
     assert_eq!(rows.len(), 2);
     assert_eq!((&rows[0][0], &rows[1][0]), ("cwbvh", "bvh2"));
     assert_eq!(
@@ -990,9 +996,9 @@ fn bench_tables_are_csv_with_named_columns() {
         predict.to_str().unwrap(),
     ]);
     assert!(run.status.success(), "{run:?}");
-    let mut r = csv::Reader::from_path(&predict).unwrap();
+    let (header, rows) = csv_table(&predict);
     assert_eq!(
-        r.headers().unwrap().iter().collect::<Vec<_>>(),
+        header,
         [
             "case",
             "method",
@@ -1002,7 +1008,6 @@ fn bench_tables_are_csv_with_named_columns() {
             "threads"
         ]
     );
-    let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
     let spatial: Vec<_> = rows
         .iter()
         .filter(|r| r[1].starts_with("spatial"))

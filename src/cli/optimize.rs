@@ -331,7 +331,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     };
     println!(
         "{} set(s) of {} points for {} in {:.2} s ({coarse}{} iterations for set 0); loss {:.4e}",
-        a.sets, a.n, a.target, design.seconds, design.iterations[0], design.mean_loss
+        a.sets, a.n, a.target, design.run.seconds, design.iterations[0], design.mean_loss
     );
     if let Some(v) = design.exact_variance {
         if v <= design.rounding {
@@ -356,7 +356,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
             } else {
                 "loss"
             },
-            design.init
+            design.run.init
         );
     }
     for (name, v) in &design.comparison {
@@ -435,8 +435,8 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
         a.sets,
         a.n,
         design.terms.len(),
-        design.seconds,
-        design.init
+        design.run.seconds,
+        design.run.init
     );
     for t in &design.terms {
         println!(
@@ -485,7 +485,7 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     println!(
         "{} set(s) of {} points designed on the square for {} in {:.2} s (from {}); \
          unshifted estimator, scored on {} members per family (seed {})",
-        a.sets, a.n, a.target, design.seconds, design.init, a.members, a.score_seed
+        a.sets, a.n, a.target, design.run.seconds, design.run.init, a.members, a.score_seed
     );
     for (name, v) in &design.comparison {
         print!("  {name:<14}");

@@ -8,3 +8,26 @@
 pub mod projections;
 pub mod square;
 pub mod torus;
+
+use serde::Serialize;
+
+/// What every design report starts with (flattened into it).
+#[derive(Debug, Clone, Serialize)]
+pub struct DesignRun {
+    /// "torus" or "square".
+    pub domain: &'static str,
+    /// The target spec.
+    pub target: String,
+    /// Points per set.
+    pub n: usize,
+    /// Dimension.
+    pub dim: usize,
+    /// Number of sets.
+    pub sets: usize,
+    /// Seed of the starts.
+    pub seed: u64,
+    /// The starting sampler.
+    pub init: String,
+    /// Wall time of the design, seconds.
+    pub seconds: f64,
+}

@@ -7,6 +7,7 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::DesignRun;
 use crate::neighbours::closest_pair_ratio;
 use crate::optimize::projections::{ProjectionObjective, parse_projections};
 use crate::optimize::{AdamOptions, Domain, OptimizeError, adam};
@@ -64,24 +65,11 @@ pub struct ProjectionDesign {
     /// The designed sets.
     #[serde(skip)]
     pub points: Vec<PointSet>,
-    /// Always "torus".
-    pub domain: &'static str,
-    /// The target spec.
-    pub target: String,
-    /// Points per set.
-    pub n: usize,
-    /// Always 4.
-    pub dim: usize,
-    /// Number of sets.
-    pub sets: usize,
-    /// Seed of the starts.
-    pub seed: u64,
-    /// The starting sampler.
-    pub init: String,
+    /// Domain, target, sizes, seed, start and wall time.
+    #[serde(flatten)]
+    pub run: DesignRun,
     /// The iteration cap.
     pub iterations: usize,
-    /// Wall time, seconds.
-    pub seconds: f64,
     /// Per term, before and after.
     pub terms: Vec<TermLoss>,
     /// XY and UV closest pairs of the designs.
@@ -152,15 +140,17 @@ pub fn design_projections(
         uv: closest([2, 3])?,
     };
     Ok(ProjectionDesign {
-        domain: "torus",
-        target: r.target.clone(),
-        n: r.n,
-        dim: 4,
-        sets: r.sets,
-        seed: r.seed,
-        init: init_name,
+        run: DesignRun {
+            domain: "torus",
+            target: r.target.clone(),
+            n: r.n,
+            dim: 4,
+            sets: r.sets,
+            seed: r.seed,
+            init: init_name,
+            seconds,
+        },
         iterations: options.iters,
-        seconds,
         terms: terms_out,
         closest_pair_over_hexagonal: closest_pairs,
         loss: "sum of w_t L_t(M_t X) / L_t(M_t X0) over the projection terms",

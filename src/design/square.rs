@@ -8,6 +8,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::{Map, Value, json};
 
+use super::DesignRun;
 use crate::baseline::classic_baselines;
 use crate::neighbours::closest_pair_ratio;
 use crate::points::PointSet;
@@ -61,24 +62,13 @@ pub struct SquareDesign {
     /// The designed sets.
     #[serde(skip)]
     pub points: Vec<PointSet>,
-    /// Always "square".
-    pub domain: &'static str,
+    /// Domain, target, sizes, seed, start and wall time of the descents.
+    #[serde(flatten)]
+    pub run: DesignRun,
     /// The estimator scored.
     pub estimator: &'static str,
-    /// The target spec.
-    pub target: String,
-    /// Points per set.
-    pub n: usize,
-    /// Number of sets.
-    pub sets: usize,
-    /// Seed of the starts.
-    pub seed: u64,
-    /// The starting sampler.
-    pub init: String,
     /// The iteration cap.
     pub iterations: usize,
-    /// Wall time of the descents, seconds.
-    pub seconds: f64,
     /// What the loss is.
     pub loss: &'static str,
     /// Per set: the loss's score at the start.
@@ -173,15 +163,18 @@ pub fn design_on_square(
         comparison.insert(b.name.into(), json!(m));
     }
     Ok(SquareDesign {
-        domain: "square",
+        run: DesignRun {
+            domain: "square",
+            target: r.target.clone(),
+            n: r.n,
+            dim: 2,
+            sets: r.sets,
+            seed: r.seed,
+            init: init_name,
+            seconds,
+        },
         estimator: "unshifted: mean of f over the set on [0,1)^2",
-        target: r.target.clone(),
-        n: r.n,
-        sets: r.sets,
-        seed: r.seed,
-        init: init_name,
         iterations: options.iters,
-        seconds,
         loss: "sum of w_t MSE_t / MSE_t(start) (blue: repulsion / its value for uniform points); stochastic per iteration",
         score_start: results.iter().map(|x| x.start_score).collect(),
         score_best: results.iter().map(|x| x.best_score).collect(),

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 use serde_json::json;
 
+use super::DesignRun;
 use crate::baseline::{Baseline, classic_baselines};
 use crate::integrands::Integrand;
 use crate::optimize::adapted::{CheckpointPlan, Kept, design_sets};
@@ -71,20 +72,9 @@ pub struct TorusDesign {
     /// The designed sets.
     #[serde(skip)]
     pub points: Vec<PointSet>,
-    /// The target spec.
-    pub target: String,
-    /// Points per set.
-    pub n: usize,
-    /// Dimension.
-    pub dim: usize,
-    /// Number of sets.
-    pub sets: usize,
-    /// Seed of the starts.
-    pub seed: u64,
-    /// The starting sampler.
-    pub init: String,
-    /// Always "torus".
-    pub domain: &'static str,
+    /// Domain, target, sizes, seed, start and wall time.
+    #[serde(flatten)]
+    pub run: DesignRun,
     /// The box half-width h.
     pub half: usize,
     /// The box resolution 2h + 1.
@@ -93,8 +83,6 @@ pub struct TorusDesign {
     pub tolerance: f64,
     /// NUFFT upsampling factor.
     pub upsampling: f64,
-    /// Wall time of the design, seconds.
-    pub seconds: f64,
     /// Iterations run per set.
     pub iterations: Vec<usize>,
     /// Iterations on the coarse box per set.
@@ -341,18 +329,20 @@ impl TorusPlan {
         let half = self.optimizer.frequencies().half;
         Ok(TorusDesign {
             points: results.iter().map(|k| k.points.clone()).collect(),
-            target: r.target.clone(),
-            n: r.n,
-            dim: r.dim,
-            sets: r.sets,
-            seed: r.seed,
-            init: self.init_name.clone(),
-            domain: "torus",
+            run: DesignRun {
+                domain: "torus",
+                target: r.target.clone(),
+                n: r.n,
+                dim: r.dim,
+                sets: r.sets,
+                seed: r.seed,
+                init: self.init_name.clone(),
+                seconds,
+            },
             half,
             res: 2 * half + 1,
             tolerance: self.tolerance,
             upsampling: self.optimizer.upsampling(),
-            seconds,
             iterations: results.iter().map(|k| k.descent.losses.len()).collect(),
             coarse_iterations: results.iter().map(|k| k.descent.coarse_iterations).collect(),
             loss: "sum over 0 < |k|inf <= half of W(k) P_S(k)  (for an integrand target: its predicted variance within the box)",

@@ -486,7 +486,7 @@ fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
     // As `optimize points --domain square` runs it, so the printed
     // commands give these numbers.
     let design = design_on_square(&request, &|_, _| {}).map_err(at("square design"))?;
-    let seconds_per_set = design.seconds / request.sets as f64;
+    let seconds_per_set = design.run.seconds / request.sets as f64;
     let gaussians = Family::parse("gaussians").map_err(at("family"))?.spec();
     let mse = |v: &serde_json::Value, family: &str| v[family]["mse"].as_f64().unwrap_or(f64::NAN);
     // The design first, then the classic samplers.
