@@ -59,20 +59,32 @@ fn limit_value(text: &str) -> Option<u64> {
     (v < 1 << 62).then_some(v)
 }
 
-/// The smallest `limit − usage` over the process's memory cgroup and its
-/// ancestors, from /proc/self/cgroup's text and the cgroup mount `root`.
+/// The smallest `limit − (usage − inactive file cache)` over the process's
+/// memory cgroup and its ancestors, from /proc/self/cgroup's text and the
+/// cgroup mount `root`. Usage counts page cache the kernel reclaims on
+/// demand; its inactive part is subtracted, as container runtimes do
+/// (`inactive_file` in v2's memory.stat, `total_inactive_file` in v1's).
 fn cgroup_headroom(proc_cgroup: &str, root: &Path) -> Option<u64> {
     let mut best: Option<u64> = None;
     for line in proc_cgroup.lines() {
         let mut parts = line.splitn(3, ':');
-        let (_, controllers, path) = (parts.next()?, parts.next()?, parts.next()?);
-        let (base, limit_file, usage_file) = if controllers.is_empty() {
-            (root.to_path_buf(), "memory.max", "memory.current")
+        let (Some(_), Some(controllers), Some(path)) = (parts.next(), parts.next(), parts.next())
+        else {
+            continue;
+        };
+        let (base, limit_file, usage_file, inactive_key) = if controllers.is_empty() {
+            (
+                root.to_path_buf(),
+                "memory.max",
+                "memory.current",
+                "inactive_file",
+            )
         } else if controllers.split(',').any(|c| c == "memory") {
             (
                 root.join("memory"),
                 "memory.limit_in_bytes",
                 "memory.usage_in_bytes",
+                "total_inactive_file",
             )
         } else {
             continue;
@@ -85,7 +97,11 @@ fn cgroup_headroom(proc_cgroup: &str, root: &Path) -> Option<u64> {
                     .ok()
                     .and_then(|u| u.trim().parse::<u64>().ok())
                     .unwrap_or(0);
-                let room = limit.saturating_sub(usage);
+                let inactive = std::fs::read_to_string(dir.join("memory.stat"))
+                    .ok()
+                    .and_then(|stat| stat_field(&stat, inactive_key))
+                    .unwrap_or(0);
+                let room = limit.saturating_sub(usage.saturating_sub(inactive));
                 best = Some(best.map_or(room, |b| b.min(room)));
             }
             if dir == base || !dir.pop() {
@@ -94,6 +110,14 @@ fn cgroup_headroom(proc_cgroup: &str, root: &Path) -> Option<u64> {
         }
     }
     best
+}
+
+/// A `key value` line of a cgroup's memory.stat.
+fn stat_field(stat: &str, key: &str) -> Option<u64> {
+    stat.lines().find_map(|l| {
+        let (k, v) = l.split_once(' ')?;
+        (k == key).then(|| v.trim().parse().ok()).flatten()
+    })
 }
 
 /// The soft address-space limit of /proc/self/limits minus the process's
@@ -202,7 +226,13 @@ mod tests {
             |dir: &Path, name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
         // v2: the job may use 3 GiB and has 1 GiB; its parent allows more.
         write(&job, "memory.max", "3221225472\n");
-        write(&job, "memory.current", "1073741824\n");
+        // 1.5 GiB in use, of which 0.5 GiB inactive page cache: 2 GiB free.
+        write(&job, "memory.current", "1610612736\n");
+        write(
+            &job,
+            "memory.stat",
+            "anon 1073741824\nfile 536870912\ninactive_file 536870912\nactive_file 0\n",
+        );
         write(&root.join("slurm"), "memory.max", "max\n");
         write(&root, "memory.max", "17179869184\n");
         write(&root, "memory.current", "0\n");
@@ -214,7 +244,12 @@ mod tests {
         let v1 = root.join("memory/box");
         std::fs::create_dir_all(&v1).unwrap();
         write(&v1, "memory.limit_in_bytes", "1000000\n");
-        write(&v1, "memory.usage_in_bytes", "400000\n");
+        write(&v1, "memory.usage_in_bytes", "500000\n");
+        write(
+            &v1,
+            "memory.stat",
+            "cache 200000\ninactive_file 1\ntotal_inactive_file 100000\n",
+        );
         write(
             &root.join("memory"),
             "memory.limit_in_bytes",
@@ -226,6 +261,11 @@ mod tests {
         );
         // No memory controller named, nothing read.
         assert_eq!(cgroup_headroom("2:cpu:/box\n", &root), None);
+        // A malformed line is skipped, not the end of the reading.
+        assert_eq!(
+            cgroup_headroom("garbage\n3:memory:/box\n", &root),
+            Some(600_000)
+        );
         std::fs::remove_dir_all(&root).unwrap();
     }
 }

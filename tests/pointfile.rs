@@ -368,8 +368,15 @@ fn an_npy_shape_whose_product_overflows_is_refused() {
             "(18446744073709551615-9223372036854775808, 3, 2,99999999999 )",
             "not a whole number",
         ),
+        // The same in a list, and under a double-quoted key (both Python).
+        ("[9223372036854775808, 3, 2]", "holds more values"),
+        ("\"(18446744073709551615, 3, 2)", "holds more values"),
     ] {
-        let mut header = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': {shape}, }}");
+        let (key, shape) = match shape.strip_prefix('"') {
+            Some(rest) => ("\"shape\"", rest),
+            None => ("'shape'", shape),
+        };
+        let mut header = format!("{{'descr': '<f8', 'fortran_order': False, {key}: {shape}, }}");
         while (10 + header.len() + 1) % 64 != 0 {
             header.push(' ');
         }

@@ -230,3 +230,59 @@ fn a_pixels_light_field_power_lies_on_its_sheared_line() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A non-square image tells rows from columns: the .npy arrays are
+/// [height, width] with the top row first, the PFM's rows bottom-up.
+#[test]
+fn npy_images_are_height_by_width_top_row_first() {
+    let dir = temp_dir("render-npy");
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/dof.json")).unwrap();
+    let wide = text.replace("\"resolution\": [256, 256]", "\"resolution\": [48, 20]");
+    assert_ne!(text, wide);
+    let scene = dir.join("wide.json");
+    std::fs::write(&scene, wide).unwrap();
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let out = varspec_with(
+        &[
+            "render",
+            &p("wide.json"),
+            "--spp",
+            "4",
+            "--renders",
+            "2",
+            "-o",
+            &p("img.png"),
+            "--pfm",
+            &p("img.pfm"),
+            "--variance-pfm",
+            &p("var.pfm"),
+            "--variance-npy",
+            &p("var.npy"),
+        ],
+        None,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(dir.join("var.npy")).unwrap();
+    let array = npyz::NpyFile::new(&bytes[..]).unwrap();
+    assert_eq!(array.shape(), &[20, 48]);
+    let values: Vec<f64> = array.into_vec().unwrap();
+    let pfm = std::fs::read(dir.join("var.pfm")).unwrap();
+    let header = b"Pf\n48 20\n-1.0\n";
+    assert!(pfm.starts_with(header));
+    for row in 0..20 {
+        for col in 0..48 {
+            let i = header.len() + 4 * ((19 - row) * 48 + col);
+            let v = f32::from_le_bytes(pfm[i..i + 4].try_into().unwrap());
+            assert_eq!(values[row * 48 + col] as f32, v, "({row}, {col})");
+        }
+    }
+    // Not symmetric under a flip, so the comparison above sees the order.
+    let flipped: Vec<f64> = values.chunks(48).rev().flatten().copied().collect();
+    assert_ne!(values, flipped, "an image equal to its flip tells nothing");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

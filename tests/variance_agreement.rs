@@ -54,6 +54,17 @@ fn check(sampler: &dyn Sampler, name: &str, f: &dyn Integrand, sets: usize, seed
     let drawn: Vec<_> = (0..sets).map(|r| realization(r).unwrap()).collect();
     let label = format!("{name} N={n} {}", f.spec());
     common::direct::check_fourier(&label, f, &drawn, HALF, NUFFT_TOL, &four, Some(&s));
+    // The error bar users see: the Fourier form's truncation bound must
+    // cover its distance from the exact value (a test of the bound, whose
+    // tolerance is therefore the bound itself, plus NUFFT and rounding).
+    let nufft = f.variance() * (2.0 * NUFFT_TOL + NUFFT_TOL * NUFFT_TOL) * 1.01;
+    assert!(
+        (four.variance - s.variance).abs() <= four.truncation_bound + s.rounding_bound + nufft,
+        "{label}: fourier {:e} vs spatial {:e}: outside its truncation bound {:e}",
+        four.variance,
+        s.variance,
+        four.truncation_bound
+    );
     // Empirical (random shifts of 2000–4000 realizations) against the exact
     // spatial form's mean over 200 realizations (32 at N = 1024, where each
     // costs N²/2 pairs): two estimates of one expectation.

@@ -684,7 +684,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
 
 fn shear(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::integrands;
-    use varspec::optimize::shear::checked::search_and_check;
+    use varspec::optimize::shear::checked::{check_request, search_and_check};
     use varspec::optimize::shear::shear_set;
     // The pictures --png-prefix names (a pixel also gets its light field's).
     let pictures: Vec<std::path::PathBuf> = a
@@ -709,6 +709,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     }
 
     let f = integrands::parse(&a.integrand)?;
+    check_request(f.as_ref(), a.range, a.realizations)?;
     let sampler = registry::build(&a.sampler, a.n, Some(4), &[])?;
     // The written sets, drawn and sheared (two copies), and a few numbers
     // per realization of the check.

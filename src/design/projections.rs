@@ -92,6 +92,9 @@ pub fn design_projections(
     on_iteration: &(dyn Fn(usize, f64) + Sync),
 ) -> Result<ProjectionDesign, OptimizeError> {
     let r = request;
+    if r.sets == 0 {
+        return Err(OptimizeError::Option("--sets must be at least 1".into()));
+    }
     let terms = parse_projections(&r.target, r.n)?;
     let init_name = r.init.clone().unwrap_or_else(|| "umj".into());
     let init = registry::build(&init_name, r.n, Some(4), &[])?;

@@ -102,6 +102,11 @@ pub fn design_on_square(
     on_iteration: &(dyn Fn(usize, f64) + Sync),
 ) -> Result<SquareDesign, SquareDesignError> {
     let r = request;
+    if r.sets == 0 {
+        return Err(SquareDesignError::Request(
+            "--sets must be at least 1".into(),
+        ));
+    }
     let terms = parse_target(&r.target)?;
     // Scores: the designed sets and 8 or more sets of each classic sampler.
     crate::square::mse::check_family_memory(r.members, r.sets.max(8))?;

@@ -157,12 +157,22 @@ fn read_header_checked(reader: &mut impl Read) -> Result<Vec<u8>, String> {
     bytes.resize(start + header_len, 0);
     reader.read_exact(&mut bytes[start..]).map_err(short)?;
     let text = String::from_utf8_lossy(&bytes[start..]);
-    if let Some(dims) = text
+    // The shape's key in either quote, then its tuple or list.
+    let after_key = text
         .split_once("'shape'")
-        .and_then(|(_, rest)| rest.split_once('('))
-        .and_then(|(_, rest)| rest.split_once(')'))
-        .map(|(dims, _)| dims)
-    {
+        .or_else(|| text.split_once("\"shape\""))
+        .map(|(_, rest)| rest);
+    let dims = after_key.and_then(|rest| {
+        let open = rest.find(['(', '['])?;
+        let close = if rest.as_bytes()[open] == b'(' {
+            ')'
+        } else {
+            ']'
+        };
+        let inner = &rest[open + 1..];
+        inner.find(close).map(|end| &inner[..end])
+    });
+    if let Some(dims) = dims {
         // Each dimension's magnitude, whatever signs a Python literal puts
         // before it (npyz reads `--5` as 5); a digit run beyond u64 counts
         // as overflowing. Anything else (npyz would evaluate `a-b`, whose

@@ -159,8 +159,8 @@ pub struct SquareSection {
     pub target: String,
     /// Designed sets.
     pub sets: usize,
-    /// Design time per set.
-    pub seconds_per_set: f64,
+    /// Wall time of the design, all sets (designed in parallel).
+    pub seconds: f64,
     /// Members per family.
     pub members: usize,
     /// Rows.
@@ -486,7 +486,6 @@ fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
     // As `optimize points --domain square` runs it, so the printed
     // commands give these numbers.
     let design = design_on_square(&request, &|_, _| {}).map_err(at("square design"))?;
-    let seconds_per_set = design.run.seconds / request.sets as f64;
     let gaussians = Family::parse("gaussians").map_err(at("family"))?.spec();
     let mse = |v: &serde_json::Value, family: &str| v[family]["mse"].as_f64().unwrap_or(f64::NAN);
     // The design first, then the classic samplers.
@@ -527,7 +526,7 @@ fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
         n,
         target: target.into(),
         sets: request.sets,
-        seconds_per_set,
+        seconds: design.run.seconds,
         members: request.members,
         rows,
         pictures: vec![Figure {

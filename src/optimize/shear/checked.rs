@@ -30,6 +30,32 @@ pub struct CheckedShear {
     pub report: Value,
 }
 
+/// Refuses what [`search_and_check`] cannot do, before anything is built:
+/// a non-4D integrand, a range outside (0, [`MAX_SHEAR_RANGE`]], one check
+/// realization.
+///
+/// # Errors
+/// [`OptimizeError::Option`] naming what is wrong.
+pub fn check_request(
+    f: &dyn Integrand,
+    range: f64,
+    realizations: usize,
+) -> Result<(), OptimizeError> {
+    if f.dim() != 4 {
+        return Err(OptimizeError::Option(format!(
+            "the shear search needs a 4D integrand (e.g. defocus:...), {} is {}D",
+            f.spec(),
+            f.dim()
+        )));
+    }
+    if realizations == 1 || !(range.is_finite() && range > 0.0 && range <= MAX_SHEAR_RANGE) {
+        return Err(OptimizeError::Option(format!(
+            "--realizations must be 0 (no check) or at least 2, and --range a positive number up to {MAX_SHEAR_RANGE} (got {range:?})"
+        )));
+    }
+    Ok(())
+}
+
 /// Searches the shear of `sampler` (named `sampler_name`) for `f` within
 /// [−range, range]² and checks it on `realizations` fresh realizations
 /// (0: no check).
@@ -45,18 +71,7 @@ pub fn search_and_check(
     range: f64,
     realizations: usize,
 ) -> Result<CheckedShear, OptimizeError> {
-    if f.dim() != 4 {
-        return Err(OptimizeError::Option(format!(
-            "the shear search needs a 4D integrand (e.g. defocus:...), {} is {}D",
-            f.spec(),
-            f.dim()
-        )));
-    }
-    if realizations == 1 || !(range.is_finite() && range > 0.0 && range <= MAX_SHEAR_RANGE) {
-        return Err(OptimizeError::Option(format!(
-            "--realizations must be 0 (no check) or at least 2, and --range a positive number up to {MAX_SHEAR_RANGE} (got {range:?})"
-        )));
-    }
+    check_request(f, range, realizations)?;
     let start = std::time::Instant::now();
     let spectral = spectral_start(f, 64, range);
     let mut starts = spectral.candidates();
