@@ -47,11 +47,13 @@ fn check(sampler: &dyn Sampler, name: &str, f: &dyn Integrand, sets: usize, seed
     let realization = |r: usize| -> Result<_, VarianceError> {
         Ok(sampler.sample(&mut set_rng(seed, r as u64))?)
     };
-    let s = spatial(f, sets, realization).unwrap();
-    let four = fourier(f, HALF, NUFFT_TOL, sets, realization).unwrap();
+    // Drawn once, lent to both forms and to the direct check.
+    let drawn: Vec<_> = (0..sets).map(|r| realization(r).unwrap()).collect();
+    let lend = |r: usize| -> Result<_, VarianceError> { Ok(drawn[r].clone()) };
+    let s = spatial(f, sets, lend).unwrap();
+    let four = fourier(f, HALF, NUFFT_TOL, sets, lend).unwrap();
     // Both forms on the same sets against a direct DFT written in the test
     // and the rigorous limits of the tail (tests/common/direct.rs).
-    let drawn: Vec<_> = (0..sets).map(|r| realization(r).unwrap()).collect();
     let label = format!("{name} N={n} {}", f.spec());
     common::direct::check_fourier(&label, f, &drawn, HALF, NUFFT_TOL, &four, Some(&s));
     // The error bar users see: the Fourier form's truncation bound must
