@@ -21,8 +21,14 @@
 //! shows. When most of the integrand's energy lies beyond the box (tiny
 //! disks, hairlines, k₀ outside B) the shell's max P_f says nothing about
 //! the outside and the fluctuation term uses Σ_(k∉B) P_f² ≤ T² instead: the
-//! bound is then wide, and says so. The bound is an estimate from the data,
-//! not a theorem: it assumes the shell represents the frequencies beyond it.
+//! bound is then wide, and says so. When the whole shell is dark (every
+//! N·P_S below 1/20: a lattice-like set, uniform jitter or a rank-1
+//! lattice, whose first dual ring lies beyond the box) the shell cannot
+//! stand for what lies beyond — that ring may carry N·P_S = N where P_f is
+//! large — and the bound is the rigorous one, (max_S |S|²/N − 1)·T/N with
+//! |S| ≤ N: wide, and a sign that the box must grow. Otherwise the bound is
+//! an estimate from the data, not a theorem: it assumes the shell
+//! represents the frequencies beyond it.
 //!
 //! Sets with a density λ (a random number of points, weight 1/λ) use
 //! P_S = |S|²/λ and λ in place of N throughout, plus the k = 0 term
@@ -40,6 +46,9 @@ use crate::sum::NeumaierSum;
 /// Shell deviation |N·P_S − 1| above which the spectrum is treated as a
 /// lattice's (see the module doc).
 const LATTICE_SPIKE: f64 = 20.0;
+/// Shell power N·P_S below which every shell frequency counts as dark (see
+/// the module doc).
+const DARK_SHELL: f64 = 0.05;
 
 /// The Fourier prediction.
 #[derive(Debug, Clone, PartialEq)]
@@ -236,8 +245,13 @@ where
         ((2.0 * mean_w.abs()).max(mean.abs()), sd_w, pf_max)
     };
     let worst = shell.iter().map(|s| s.0.abs()).fold(0.0, f64::max);
+    let dark = !shell.is_empty() && shell.iter().all(|s| s.0 + 1.0 < DARK_SHELL);
     let truncation_bound = if worst > LATTICE_SPIKE {
         worst * tail_mass / nf
+    } else if dark {
+        // |S(k)|² ≤ c² for c points: N·P_S = |S|²/λ ≤ c²/λ beyond the box.
+        let largest = counts.iter().copied().max().unwrap_or(0) as f64;
+        (largest * largest / nf - 1.0).max(1.0) * tail_mass / nf
     } else if tail_mass > mass.value() {
         // Most of the energy lies beyond the box, where the shell's max P_f
         // says nothing: use the rigorous Σ_(k∉B) P_f² ≤ T².
