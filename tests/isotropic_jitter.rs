@@ -78,14 +78,14 @@ fn spatial_fourier_and_empirical_forms_agree_with_a_random_count() {
     let sets = draw(sampler.as_ref(), 5, 256);
     let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(sets[r].clone()) };
     let s = spatial(f.as_ref(), sets.len(), lend).unwrap();
-    let four = fourier(f.as_ref(), 255, 1e-10, sets.len(), lend).unwrap();
+    let four = fourier(f.as_ref(), 127, 1e-10, sets.len(), lend).unwrap();
     // Same sets: both forms against a direct DFT with weights 1/λ and the
     // rigorous limits of the tail (tests/common/direct.rs).
     common::direct::check_fourier(
         "isotropic jitter",
         f.as_ref(),
         &sets,
-        255,
+        127,
         1e-10,
         &four,
         Some(&s),

@@ -11,11 +11,12 @@
 
 mod common;
 
+use rayon::prelude::*;
+use varspec::PointSet;
 use varspec::integrands::{self, Integrand};
 use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::Sampler;
-use varspec::variance::{VarianceError, empirical, fourier, spatial};
+use varspec::variance::{SpatialEstimate, VarianceError, empirical, fourier, spatial};
 
 const SAMPLERS: [&str; 9] = [
     "random",
@@ -42,20 +43,26 @@ const NUFFT_TOL: f64 = 1e-10;
 /// The Fourier form's box |k|∞ ≤ HALF.
 const HALF: usize = 63;
 
-fn check(sampler: &dyn Sampler, name: &str, f: &dyn Integrand, sets: usize, seed: u64) {
-    let n = sampler.points_per_set();
-    let realization = |r: usize| -> Result<_, VarianceError> {
-        Ok(sampler.sample(&mut set_rng(seed, r as u64))?)
-    };
-    // Drawn once, lent to both forms and to the direct check.
-    let drawn: Vec<_> = (0..sets).map(|r| realization(r).unwrap()).collect();
-    let lend = |r: usize| -> Result<_, VarianceError> { Ok(drawn[r].clone()) };
+/// Realizations for the empirical form (2000 at N = 1024, 4000 below) and
+/// the spatial mean (32 and 200): drawn once per sampler, lent to every
+/// integrand.
+fn realizations(n: usize) -> (usize, usize) {
+    if n > 256 { (2000, 32) } else { (4000, 200) }
+}
+
+/// `pool[..sets]` go to both forms and the direct check.
+fn check(name: &str, f: &dyn Integrand, pool: &[PointSet], sets: usize, seed: u64) {
+    let n = pool[0].len();
+    let (shifted, total) = realizations(n);
+    let realization = |r: usize| -> Result<_, VarianceError> { Ok(pool[r].clone()) };
+    let drawn = &pool[..sets];
+    let lend = realization;
     let s = spatial(f, sets, lend).unwrap();
     let four = fourier(f, HALF, NUFFT_TOL, sets, lend).unwrap();
     // Both forms on the same sets against a direct DFT written in the test
     // and the rigorous limits of the tail (tests/common/direct.rs).
     let label = format!("{name} N={n} {}", f.spec());
-    common::direct::check_fourier(&label, f, &drawn, HALF, NUFFT_TOL, &four, Some(&s));
+    common::direct::check_fourier(&label, f, drawn, HALF, NUFFT_TOL, &four, Some(&s));
     // The error bar users see: the Fourier form's truncation bound must
     // cover its distance from the exact value (a test of the bound, whose
     // tolerance is therefore the bound itself, plus NUFFT and rounding).
@@ -69,9 +76,11 @@ fn check(sampler: &dyn Sampler, name: &str, f: &dyn Integrand, sets: usize, seed
     );
     // Empirical (random shifts of 2000–4000 realizations) against the exact
     // spatial form's mean over 200 realizations (32 at N = 1024, where each
-    // costs N²/2 pairs): two estimates of one expectation.
-    let many = spatial(f, if n > 256 { 32 } else { 200 }, realization).unwrap();
-    let e = empirical(f, if n > 256 { 2000 } else { 4000 }, seed + 1, realization).unwrap();
+    // costs N²/2 pairs): two estimates of one expectation. The first `sets`
+    // realizations are those already drawn; only the rest are computed.
+    let rest = spatial(f, total - sets, |r| realization(sets + r)).unwrap();
+    let many = pooled(&s, &rest);
+    let e = empirical(f, shifted, seed + 1, realization).unwrap();
     let combined = (e.stderr * e.stderr + many.stderr * many.stderr).sqrt();
     assert!(
         (e.variance - many.variance).abs() <= Z * combined + many.rounding_bound,
@@ -85,12 +94,37 @@ fn check(sampler: &dyn Sampler, name: &str, f: &dyn Integrand, sets: usize, seed
     );
 }
 
+/// The spatial form's mean over two disjoint groups of realizations, with the
+/// standard error of the pooled per-set values (the two groups' sums of
+/// squared deviations plus the between-group term).
+fn pooled(a: &SpatialEstimate, b: &SpatialEstimate) -> SpatialEstimate {
+    let (na, nb) = (a.sets as f64, b.sets as f64);
+    let n = na + nb;
+    let mean = (na * a.variance + nb * b.variance) / n;
+    // Per-set sample variance from a standard error: s² = stderr²·count.
+    let squares = |e: &SpatialEstimate| e.stderr * e.stderr * e.sets as f64 * (e.sets as f64 - 1.0);
+    let delta = a.variance - b.variance;
+    let per_set = (squares(a) + squares(b) + na * nb / n * delta * delta) / (n - 1.0);
+    SpatialEstimate {
+        variance: mean,
+        rounding_bound: a.rounding_bound.max(b.rounding_bound),
+        stderr: (per_set / n).sqrt(),
+        sets: a.sets + b.sets,
+    }
+}
+
 fn run_for(n: usize) {
-    for spec in INTEGRANDS {
-        let f = integrands::parse(spec).unwrap();
-        for name in SAMPLERS {
-            let sampler = registry::build(name, n, Some(2), &[]).unwrap();
-            check(sampler.as_ref(), name, f.as_ref(), 12, 1000 + n as u64);
+    let seed = 1000 + n as u64;
+    let (shifted, total) = realizations(n);
+    for name in SAMPLERS {
+        let sampler = registry::build(name, n, Some(2), &[]).unwrap();
+        let pool: Vec<PointSet> = (0..shifted.max(total))
+            .into_par_iter()
+            .map(|r| sampler.sample(&mut set_rng(seed, r as u64)).unwrap())
+            .collect();
+        for spec in INTEGRANDS {
+            let f = integrands::parse(spec).unwrap();
+            check(name, f.as_ref(), &pool, 12, seed);
         }
     }
 }
