@@ -861,6 +861,7 @@ fn experiment_help_describes_the_file() {
         "n ",
         "sets ",
         "seed ",
+        "radial ",
     ] {
         assert!(
             text.contains(&format!("\n  {field}")),

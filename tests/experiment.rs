@@ -13,7 +13,8 @@ const SMALL: &str = r#"{
   "integrands": ["disk:r=0.3", "gaussian:sx=0.1"],
   "n": [16, 64, 256],
   "sets": 4,
-  "seed": 5
+  "seed": 5,
+  "radial": {"half": 20}
 }"#;
 
 fn ok(args: &[&str]) {
@@ -47,7 +48,13 @@ fn shards_merged_equal_the_single_run_byte_for_byte() {
             ]);
         }
         ok(&["merge", sharded.to_str().unwrap()]);
-        for name in ["variances.csv", "slopes.csv", "README.md"] {
+        for name in [
+            "variances.csv",
+            "slopes.csv",
+            "radial.csv",
+            "radial-slopes.csv",
+            "README.md",
+        ] {
             let (a, b) = (
                 std::fs::read(single.join(name)).unwrap(),
                 std::fs::read(sharded.join(name)).unwrap(),
@@ -139,6 +146,24 @@ fn a_rerun_with_one_n_removes_the_stale_slopes() {
         !out.join("slopes.csv").exists(),
         "stale slopes.csv left beside a one-N table"
     );
+    assert!(
+        !out.join("radial-slopes.csv").exists(),
+        "stale radial-slopes.csv left beside a one-N table"
+    );
+    assert!(out.join("radial.csv").exists());
+    // Without the radial comparison its table goes too.
+    std::fs::write(&file, SMALL.replace(",\n  \"radial\": {\"half\": 20}", "")).unwrap();
+    ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(out.join("slopes.csv").exists());
+    assert!(
+        !out.join("radial.csv").exists() && !out.join("radial-slopes.csv").exists(),
+        "stale radial tables left beside a run without the radial comparison"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -161,6 +186,18 @@ fn duplicates_after_adjustment_are_refused_naming_the_values() {
         (
             SMALL.replace("\"cmj\"", "\"nonesuch\""),
             "sampler `nonesuch` at n = 16",
+        ),
+        (
+            SMALL.replace("\"half\": 20", "\"half\": 0"),
+            "radial.half = 0 must be at least 1",
+        ),
+        (
+            SMALL.replace("\"half\": 20", "\"half\": 5000"),
+            "(10001^2 = 100020001 in 2D)",
+        ),
+        (
+            SMALL.replace("\"half\": 20", "\"halfwidth\": 20"),
+            "unknown field `halfwidth`",
         ),
     ];
     let dir = temp_dir("experiment-duplicates");
@@ -190,10 +227,140 @@ fn the_shipped_experiment_files_are_valid() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "json") {
             let text = std::fs::read_to_string(&path).unwrap();
-            varspec::experiment::Experiment::parse(&text, &path.display().to_string())
+            varspec::experiment::ExperimentFile::parse(&text, &path.display().to_string())
                 .unwrap_or_else(|e| panic!("{e}"));
             checked += 1;
         }
     }
     assert!(checked >= 4, "only {checked} experiment files found");
+}
+
+/// The shipped figure experiment at reduced size (fewer sets, smaller N):
+/// every figure is drawn as a PNG that decodes to its plot, the README
+/// names each file, and the shear's gain shows in its table.
+#[test]
+fn the_seed_figures_experiment_draws_every_figure() {
+    use varspec::experiment::{Figure, FigureExperiment};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("experiments")
+        .join("seed-figures.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mut e = FigureExperiment::parse(&text, "seed-figures.json").unwrap();
+    for figure in &mut e.figures {
+        match figure {
+            Figure::RadialSpectra { sets, n, .. }
+            | Figure::Spectrum { sets, n, .. }
+            | Figure::Ingredients { sets, n, .. }
+            | Figure::Projections { sets, n, .. } => {
+                *sets = 8;
+                *n = 256;
+            }
+            Figure::ShearConvergence {
+                n, realizations, ..
+            } => {
+                *n = vec![64, 256];
+                *realizations = 400;
+            }
+        }
+    }
+    let dir = temp_dir("figures");
+    let md = e.run("seed-figures.json", &dir, &|| {}).unwrap();
+    let mut pngs = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.extension().is_some_and(|x| x == "png") {
+            let img = image::open(&p).unwrap_or_else(|err| panic!("{}: {err}", p.display()));
+            assert!(img.width() >= 200 && img.height() >= 200, "{}", p.display());
+            let stem = p.file_name().unwrap().to_string_lossy().into_owned();
+            // Files of one figure are named together: PREFIX-{a,b,c}.png.
+            let (prefix, part) = stem.trim_end_matches(".png").rsplit_once('-').unwrap();
+            let named = md.contains(&stem)
+                || md.lines().any(|l| {
+                    l.contains(&format!("`{prefix}-{{"))
+                        && l.split(['{', '}'])
+                            .nth(1)
+                            .unwrap_or("")
+                            .split(',')
+                            .any(|p| p == part)
+                });
+            assert!(named, "README does not name {stem}:\n{md}");
+            pngs += 1;
+        }
+    }
+    assert_eq!(pngs, 13, "{md}");
+    // The shear's table: every row's ratio above 2 (measured 3.5 and 6.7).
+    let ratios: Vec<f64> = md
+        .lines()
+        .filter(|l| l.starts_with("| 64 |") || l.starts_with("| 256 |"))
+        .map(|l| {
+            let cell = l.trim_end_matches('|').rsplit('|').next().unwrap();
+            cell.trim().trim_end_matches('×').parse().unwrap()
+        })
+        .collect();
+    assert!(
+        ratios.len() == 2 && ratios.iter().all(|&r| r > 2.0),
+        "{ratios:?}\n{md}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn figure_experiments_refuse_what_they_cannot_draw() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("experiments")
+        .join("seed-figures.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let cases = [
+        (
+            text.replace("\"nrooks-radial.png\"", "\"nrooks-spectrum.png\""),
+            "figures[3]: file `nrooks-spectrum.png` is written twice",
+        ),
+        (
+            text.replace("\"figure\": \"spectrum\"", "\"figure\": \"heatmap\""),
+            "unknown variant `heatmap`",
+        ),
+        (
+            text.replace("defocus:shape=disk,size=0.3,c=0.5", "disk:r=0.3"),
+            "figures[6]: integrand `disk:r=0.3` must be 4D",
+        ),
+        (
+            text.replace("\"sampler\": \"umj\"", "\"sampler\": \"cmj\""),
+            "figures[4]: sampler `cmj`",
+        ),
+        (
+            text.replace("\"res\": 160", "\"res\": 100000"),
+            "figures[0]: res = 100000 must be in 1 ..= 2048",
+        ),
+        (
+            text.replace("\"radial-jitter-vs-poisson-disk.png\"", "\"../x.png\""),
+            "plain file name",
+        ),
+        (
+            text.replace("\"kind\": \"figures\"", "\"kind\": \"plots\""),
+            "kind `plots`",
+        ),
+    ];
+    let dir = temp_dir("figure-refusals");
+    for (body, said) in &cases {
+        let file = dir.join("f.json");
+        std::fs::write(&file, body).unwrap();
+        let out = dir.join("out");
+        assert_fails(
+            &[
+                "experiment",
+                file.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            said,
+        );
+        assert!(!out.exists(), "a refused experiment left a folder");
+    }
+    let file = dir.join("f.json");
+    std::fs::write(&file, &text).unwrap();
+    assert_fails(
+        &["experiment", file.to_str().unwrap(), "--shard", "0/2"],
+        "a figure experiment runs whole",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

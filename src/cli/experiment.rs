@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 
 use super::progress;
-use varspec::experiment::{Experiment, Shard, ShardFile, merge_shards, run_items, write_results};
+use varspec::experiment::{
+    ExperimentFile, Shard, ShardFile, merge_shards, run_items, write_results,
+};
 use varspec::io::write_atomic;
 
 #[derive(clap::Args)]
@@ -22,10 +24,16 @@ The experiment file is one JSON object (docs/formats.md, \"Experiment file\"):
   n            array of requested N, required; each sampler uses its nearest valid N
   sets         realizations per (sampler, N), default 16
   seed         seed of the realizations, default 0
-Unknown fields are an error. Example: experiments/rates.json")]
+  radial       {\"half\": H}: also the radial predictor and the Fourier form on
+               the box |k| <= H, from the same realizations (radial.csv)
+Unknown fields are an error. Examples: experiments/rates.json,
+experiments/radial-failure.json.
+With \"kind\": \"figures\" the file lists figures instead (name, description,
+seed, figures: radial-spectra, spectrum, ingredients, shear-convergence;
+docs/formats.md, \"Figure experiments\"), e.g. experiments/seed-figures.json")]
 pub struct Args {
     /// Experiment file (JSON; fields in docs/formats.md): name, description,
-    /// samplers, integrands, n, sets, seed.
+    /// samplers, integrands, n, sets, seed, radial.
     file: PathBuf,
     /// Output folder (default out/experiments/<name>; results/ only when
     /// asked for, so tracked files are not overwritten by accident).
@@ -50,11 +58,29 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let file = a.file.display().to_string();
     let text = varspec::io::read_text_bounded(&a.file, 16 << 20, "an experiment file")
         .with_context(|| format!("cannot read {file}"))?;
-    let e = Experiment::parse(&text, &file)?;
+    let parsed = ExperimentFile::parse(&text, &file)?;
     let out = a
         .output
         .clone()
-        .unwrap_or_else(|| Path::new("out/experiments").join(&e.name));
+        .unwrap_or_else(|| Path::new("out/experiments").join(parsed.name()));
+    let e = match parsed {
+        ExperimentFile::Variance(e) => e,
+        ExperimentFile::Figures(e) => {
+            if a.shard.is_some() {
+                bail!(
+                    "{file}: a figure experiment runs whole; --shard splits variance experiments"
+                );
+            }
+            let bar = progress::bar(e.figures.len() as u64, &e.name);
+            std::fs::create_dir_all(&out)
+                .with_context(|| format!("{file}: cannot create {}", out.display()))?;
+            let md = e.run(&file, &out, &|| bar.inc(1))?;
+            bar.finish_and_clear();
+            print!("{md}");
+            println!("wrote {}", out.display());
+            return Ok(());
+        }
+    };
     let shard = a.shard.unwrap_or(Shard::ALL);
     let total = e.items().len() * e.integrands.len();
     let bar = progress::bar((total / shard.count).max(1) as u64, &e.name);

@@ -1,4 +1,6 @@
-//! Declarative experiments, as a library: a JSON file names samplers,
+//! Declarative experiments, as a library. Figure experiments
+//! (`"kind": "figures"`, [`FigureExperiment`]) draw a list of figures. Variance
+//! experiments (the default kind): a JSON file names samplers,
 //! integrands and sizes ([`Experiment`]); the work splits into items — one
 //! per (sampler, N), whose realizations every integrand shares — in a fixed
 //! order, so any 1/n of it ([`Shard`]) is a pure function of (i, n) and the
@@ -6,10 +8,13 @@
 //! (the partitioning of cargo-nextest's `--partition count:i/n` and of a
 //! Slurm job array). [`report`] writes the tables from the cells.
 
+mod figures;
 mod report;
 mod run;
 mod spec;
 
+pub use figures::{Figure, FigureExperiment};
+
 pub use report::{remove_other_runs, write_results};
-pub use run::{Cell, Shard, ShardFile, merge_shards, run_items};
-pub use spec::{Experiment, ExperimentError};
+pub use run::{Cell, RadialCell, Shard, ShardFile, merge_shards, run_items};
+pub use spec::{Experiment, ExperimentError, ExperimentFile, RadialComparison};

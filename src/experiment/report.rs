@@ -1,6 +1,7 @@
 //! The tables of an experiment, from its cells: `variances.csv`,
-//! `slopes.csv` (with two or more N) and a `README.md` with the command that
-//! made them. A single run and a merge of its shards write the same bytes.
+//! `slopes.csv` (with two or more N), `radial.csv` and `radial-slopes.csv`
+//! (when the experiment compares the radial predictor) and a `README.md`
+//! with the command that made them. A single run and a merge of its shards write the same bytes.
 
 use std::path::Path;
 
@@ -8,9 +9,9 @@ use super::run::{Cell, Shard};
 use super::spec::{Experiment, ExperimentError};
 use crate::integrands;
 use crate::io::write_atomic;
-use crate::variance::{fit_slope, theoretical_rate};
+use crate::variance::{SlopeFit, fit_slope, theoretical_rate};
 
-/// Writes the three files into `out` and returns the README's text.
+/// Writes the tables into `out` and returns the README's text.
 ///
 /// # Errors
 /// [`ExperimentError::Invalid`] naming the file that could not be written.
@@ -24,34 +25,69 @@ pub fn write_results(
         file: file.to_string(),
         reason: format!("writing {what}: {err}"),
     };
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record([
-        "sampler",
-        "integrand",
-        "n",
-        "variance",
-        "stderr",
-        "method",
-        "sets",
-    ])
-    .map_err(|err| fail("variances.csv", err.to_string()))?;
-    for c in cells {
-        w.write_record([
-            c.sampler.clone(),
-            c.integrand.clone(),
-            c.n.to_string(),
-            format!("{:e}", c.variance),
-            c.stderr.map_or(String::new(), |s| format!("{s:e}")),
-            c.method.clone(),
-            e.sets.to_string(),
-        ])
-        .map_err(|err| fail("variances.csv", err.to_string()))?;
+    let rows: Vec<Vec<String>> = cells
+        .iter()
+        .map(|c| {
+            vec![
+                c.sampler.clone(),
+                c.integrand.clone(),
+                c.n.to_string(),
+                format!("{:e}", c.variance),
+                c.stderr.map_or(String::new(), |s| format!("{s:e}")),
+                c.method.clone(),
+                e.sets.to_string(),
+            ]
+        })
+        .collect();
+    write_csv(
+        out,
+        "variances.csv",
+        &[
+            "sampler",
+            "integrand",
+            "n",
+            "variance",
+            "stderr",
+            "method",
+            "sets",
+        ],
+        &rows,
+        &fail,
+    )?;
+    if e.radial.is_some() {
+        let rows: Vec<Vec<String>> = cells
+            .iter()
+            .filter_map(|c| {
+                let r = c.radial?;
+                Some(vec![
+                    c.sampler.clone(),
+                    c.integrand.clone(),
+                    c.n.to_string(),
+                    format!("{:e}", c.variance),
+                    format!("{:e}", r.variance),
+                    format!("{:e}", r.variance / c.variance - 1.0),
+                    format!("{:e}", r.anisotropy_bound),
+                    format!("{:e}", r.fourier),
+                ])
+            })
+            .collect();
+        write_csv(
+            out,
+            "radial.csv",
+            &[
+                "sampler",
+                "integrand",
+                "n",
+                "reference",
+                "radial",
+                "radial_relative_error",
+                "anisotropy_bound",
+                "fourier",
+            ],
+            &rows,
+            &fail,
+        )?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|err| fail("variances.csv", err.to_string()))?;
-    write_atomic(&out.join("variances.csv"), |w| w.write_all(&bytes))
-        .map_err(|err| fail("variances.csv", err.to_string()))?;
 
     let functions: Vec<_> = e
         .integrands
@@ -112,11 +148,32 @@ pub fn write_results(
             },
         );
     }
+    if let Some(r) = e.radial {
+        md += &format!(
+            "Radial (isotropic) form on the box |k|∞ ≤ {} from the same realizations, \
+             against the reference above: radial / reference − 1 (radial.csv has the values, \
+             the Cauchy–Schwarz anisotropy bound and the Fourier form on that box).\n\n",
+            r.half
+        );
+        for (ni, &requested) in e.n.iter().enumerate() {
+            table(
+                &mut md,
+                &format!("Radial form's relative error at N ≈ {requested}"),
+                &|s, i| {
+                    pick(s, i)
+                        .into_iter()
+                        .find(|c| c.n_index == ni)
+                        .and_then(|c| c.radial.map(|r| r.variance / c.variance - 1.0))
+                        .map_or("–".into(), |x| format!("{x:+.2}"))
+                },
+            );
+        }
+    }
     if e.n.len() >= 2 {
-        let fit = |s: usize, i: usize| {
+        let fit_of = |s: usize, i: usize, value: &dyn Fn(&Cell) -> Option<f64>| {
             let cs = pick(s, i);
             let ns: Vec<f64> = cs.iter().map(|c| c.n as f64).collect();
-            let vs: Vec<f64> = cs.iter().map(|c| c.variance).collect();
+            let vs: Vec<f64> = cs.iter().map(|c| value(c).unwrap_or(f64::NAN)).collect();
             let distinct = {
                 let mut v = ns.clone();
                 v.sort_by(f64::total_cmp);
@@ -127,6 +184,16 @@ pub fn write_results(
                 .then(|| fit_slope(&ns, &vs).ok())
                 .flatten()
         };
+        let fit = |s: usize, i: usize| fit_of(s, i, &|c| Some(c.variance));
+        let radial_fit = |s: usize, i: usize| fit_of(s, i, &|c| c.radial.map(|r| r.variance));
+        let shown = |fit: Option<SlopeFit>| {
+            fit.map(|f| {
+                let ci = f
+                    .slope_ci
+                    .map_or(String::new(), |(l, h)| format!(" [{l:.2}, {h:.2}]"));
+                format!("{:.2}{ci}", f.slope)
+            })
+        };
         table(
             &mut md,
             "Fitted rate: slope of log Var on log N [95% CI] (theory)",
@@ -134,54 +201,83 @@ pub fn write_results(
                 let theory =
                     theoretical_rate(&e.samplers[s], functions[i].class(), functions[i].dim());
                 let th = theory.map_or(String::new(), |t| format!(" ({t})"));
-                match fit(s, i) {
+                match shown(fit(s, i)) {
                     None => format!("no slope: fewer than two distinct N or a zero variance{th}"),
-                    Some(f) => {
-                        let ci = f
-                            .slope_ci
-                            .map_or(String::new(), |(l, h)| format!(" [{l:.2}, {h:.2}]"));
-                        format!("{:.2}{ci}{th}", f.slope)
-                    }
+                    Some(f) => format!("{f}{th}"),
                 }
             },
         );
-        let mut w = csv::Writer::from_writer(Vec::new());
-        w.write_record([
-            "sampler",
-            "integrand",
-            "slope",
-            "ci_low",
-            "ci_high",
-            "theory",
-        ])
-        .map_err(|err| fail("slopes.csv", err.to_string()))?;
+        if e.radial.is_some() {
+            table(
+                &mut md,
+                "Rate the radial form predicts: slope of log Var on log N [95% CI]",
+                &|s, i| shown(radial_fit(s, i)).unwrap_or_else(|| "no slope".into()),
+            );
+        }
+        let ci = |v: Option<f64>| v.map_or(String::new(), |x| x.to_string());
+        let mut rows = Vec::new();
+        let mut radial_rows = Vec::new();
         for (si, s) in e.samplers.iter().enumerate() {
             for (i, f) in functions.iter().enumerate() {
                 if let Some(fit) = fit(si, i) {
-                    let ci = |v: Option<f64>| v.map_or(String::new(), |x| x.to_string());
                     let th = theoretical_rate(s, f.class(), f.dim())
                         .map_or(String::new(), |t| t.to_string());
-                    w.write_record([
+                    rows.push(vec![
                         s.clone(),
                         f.spec(),
                         fit.slope.to_string(),
                         ci(fit.slope_ci.map(|c| c.0)),
                         ci(fit.slope_ci.map(|c| c.1)),
                         th,
-                    ])
-                    .map_err(|err| fail("slopes.csv", err.to_string()))?;
+                    ]);
+                }
+                if let Some(fit) = radial_fit(si, i) {
+                    radial_rows.push(vec![
+                        s.clone(),
+                        f.spec(),
+                        fit.slope.to_string(),
+                        ci(fit.slope_ci.map(|c| c.0)),
+                        ci(fit.slope_ci.map(|c| c.1)),
+                    ]);
                 }
             }
         }
-        let bytes = w
-            .into_inner()
-            .map_err(|err| fail("slopes.csv", err.to_string()))?;
-        write_atomic(&out.join("slopes.csv"), |w| w.write_all(&bytes))
-            .map_err(|err| fail("slopes.csv", err.to_string()))?;
-    } else if out.join("slopes.csv").exists() {
-        // A previous run's slopes must not sit beside tables without them.
-        std::fs::remove_file(out.join("slopes.csv"))
-            .map_err(|err| fail("slopes.csv (stale)", err.to_string()))?;
+        write_csv(
+            out,
+            "slopes.csv",
+            &[
+                "sampler",
+                "integrand",
+                "slope",
+                "ci_low",
+                "ci_high",
+                "theory",
+            ],
+            &rows,
+            &fail,
+        )?;
+        if e.radial.is_some() {
+            write_csv(
+                out,
+                "radial-slopes.csv",
+                &["sampler", "integrand", "slope", "ci_low", "ci_high"],
+                &radial_rows,
+                &fail,
+            )?;
+        }
+    }
+    // A previous run's tables must not sit beside tables without them.
+    let written = |name: &str| match name {
+        "slopes.csv" => e.n.len() >= 2,
+        "radial.csv" => e.radial.is_some(),
+        "radial-slopes.csv" => e.radial.is_some() && e.n.len() >= 2,
+        _ => true,
+    };
+    for name in TABLES {
+        if !written(name) && out.join(name).exists() {
+            std::fs::remove_file(out.join(name))
+                .map_err(|err| fail(&format!("{name} (stale)"), err.to_string()))?;
+        }
     }
     write_atomic(&out.join("README.md"), |w| w.write_all(md.as_bytes()))
         .map_err(|err| fail("README.md", err.to_string()))?;
@@ -225,4 +321,31 @@ pub fn remove_other_runs(out: &Path, shard: Option<Shard>) -> Result<(), Experim
 }
 
 /// The files a whole run (or `merge`) writes.
-const TABLES: [&str; 3] = ["README.md", "variances.csv", "slopes.csv"];
+const TABLES: [&str; 5] = [
+    "README.md",
+    "variances.csv",
+    "slopes.csv",
+    "radial.csv",
+    "radial-slopes.csv",
+];
+
+/// Writes `rows` under `header` to `out/name` through the csv crate,
+/// atomically.
+fn write_csv(
+    out: &Path,
+    name: &str,
+    header: &[&str],
+    rows: &[Vec<String>],
+    fail: &dyn Fn(&str, String) -> ExperimentError,
+) -> Result<(), ExperimentError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(header)
+        .map_err(|err| fail(name, err.to_string()))?;
+    for row in rows {
+        w.write_record(row)
+            .map_err(|err| fail(name, err.to_string()))?;
+    }
+    let bytes = w.into_inner().map_err(|err| fail(name, err.to_string()))?;
+    write_atomic(&out.join(name), |w| w.write_all(&bytes))
+        .map_err(|err| fail(name, err.to_string()))
+}

@@ -1,12 +1,16 @@
 //! Running an experiment's items, whole or by shard, and merging shards.
 
 use crate::registry;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::spec::{Experiment, ExperimentError};
 use crate::integrands;
 use crate::samplers;
-use crate::variance::{VarianceError, VarianceForm, sampler_variance};
+use crate::variance::{VarianceError, VarianceForm, fourier_parts, radial_from, sampler_variance};
+
+/// The NUFFT tolerance of the radial comparison's spectra.
+const RADIAL_TOLERANCE: f64 = 1e-10;
 
 /// One (sampler, integrand, N) result.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -31,6 +35,22 @@ pub struct Cell {
     pub stderr: Option<f64>,
     /// `spatial` or `fourier`.
     pub method: String,
+    /// The radial predictor on the same realizations, when the experiment
+    /// asks for it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radial: Option<RadialCell>,
+}
+
+/// The radial (isotropic) predictor of one cell, with the Fourier form on
+/// the same box.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RadialCell {
+    /// (1/N) Σ_r n_r P̄_S(r) P̄_f(r) + tail/N.
+    pub variance: f64,
+    /// Cauchy–Schwarz bound on |radial − Fourier| inside the box.
+    pub anisotropy_bound: f64,
+    /// The Fourier form on the same box.
+    pub fourier: f64,
 }
 
 /// A deterministic 1/count of the items: those with index ≡ `index` (mod
@@ -120,15 +140,19 @@ pub struct ShardFile {
     pub cells: Vec<Cell>,
 }
 
-/// Runs the items of `shard` (in order); `on_cell` is called per cell.
+/// Runs the items of `shard`, two or more at a time on rayon's pool (each
+/// item's realizations and cells depend only on the item, so the cells,
+/// returned in item order, are the same for any thread count); `on_cell`
+/// is called per cell.
 ///
 /// # Errors
-/// [`ExperimentError::Cell`] naming the sampler, N and integrand that failed.
+/// [`ExperimentError::Cell`] naming the sampler, N and integrand that failed
+/// (the first in item order).
 pub fn run_items(
     e: &Experiment,
     file: &str,
     shard: Shard,
-    on_cell: &dyn Fn(),
+    on_cell: &(dyn Fn() + Sync),
 ) -> Result<Vec<Cell>, ExperimentError> {
     let functions: Vec<_> = e
         .integrands
@@ -136,43 +160,72 @@ pub fn run_items(
         .map(|s| integrands::parse(s).expect("validated with the experiment"))
         .collect();
     let dim = e.dim();
-    let mut cells = Vec::new();
-    for (item, (si, ni)) in e.items().into_iter().enumerate() {
-        if !shard.owns(item) {
-            continue;
-        }
-        let (sampler, requested) = (&e.samplers[si], e.n[ni]);
-        let fail = |integrand: &str, reason: String| ExperimentError::Cell {
-            file: file.to_string(),
-            sampler: sampler.clone(),
-            n: requested,
-            integrand: integrand.to_string(),
-            reason,
-        };
-        let (s, n) = registry::build_nearest(sampler, requested, Some(dim), &[])
-            .map_err(|err| fail("-", err.to_string()))?;
-        // Realizations drawn once per item and shared by every integrand.
-        let sets = samplers::generate_sets(s.as_ref(), e.seed, e.sets, &|| {})
-            .map_err(|err| fail("-", err.to_string()))?;
-        for (fi, f) in functions.iter().enumerate() {
-            let p = sampler_variance(f.as_ref(), e.sets, VarianceForm::Auto, |r| {
-                Ok::<_, VarianceError>(sets[r].clone())
-            })
-            .map_err(|err| fail(&f.spec(), err.to_string()))?;
-            cells.push(Cell {
-                sampler_index: si,
-                integrand_index: fi,
-                n_index: ni,
+    let owned: Vec<(usize, usize)> = e
+        .items()
+        .into_iter()
+        .enumerate()
+        .filter(|&(item, _)| shard.owns(item))
+        .map(|(_, sn)| sn)
+        .collect();
+    let per_item: Vec<Result<Vec<Cell>, ExperimentError>> = owned
+        .into_par_iter()
+        .map(|(si, ni)| {
+            let mut cells = Vec::new();
+            let (sampler, requested) = (&e.samplers[si], e.n[ni]);
+            let fail = |integrand: &str, reason: String| ExperimentError::Cell {
+                file: file.to_string(),
                 sampler: sampler.clone(),
-                integrand: f.spec(),
-                requested,
-                n,
-                variance: p.variance,
-                stderr: (e.sets >= 2).then_some(p.stderr),
-                method: p.method.to_string(),
-            });
-            on_cell();
-        }
+                n: requested,
+                integrand: integrand.to_string(),
+                reason,
+            };
+            let (s, n) = registry::build_nearest(sampler, requested, Some(dim), &[])
+                .map_err(|err| fail("-", err.to_string()))?;
+            // Realizations drawn once per item and shared by every integrand.
+            let sets = samplers::generate_sets(s.as_ref(), e.seed, e.sets, &|| {})
+                .map_err(|err| fail("-", err.to_string()))?;
+            for (fi, f) in functions.iter().enumerate() {
+                let p = sampler_variance(f.as_ref(), e.sets, VarianceForm::Auto, |r| {
+                    Ok::<_, VarianceError>(sets[r].clone())
+                })
+                .map_err(|err| fail(&f.spec(), err.to_string()))?;
+                let radial = match e.radial {
+                    None => None,
+                    Some(r) => {
+                        let parts =
+                            fourier_parts(f.as_ref(), r.half, RADIAL_TOLERANCE, e.sets, |r| {
+                                Ok::<_, VarianceError>(sets[r].clone())
+                            })
+                            .map_err(|err| fail(&f.spec(), err.to_string()))?;
+                        let radial = radial_from(&parts);
+                        Some(RadialCell {
+                            variance: radial.variance,
+                            anisotropy_bound: radial.anisotropy_bound,
+                            fourier: parts.estimate.variance,
+                        })
+                    }
+                };
+                cells.push(Cell {
+                    sampler_index: si,
+                    integrand_index: fi,
+                    n_index: ni,
+                    sampler: sampler.clone(),
+                    integrand: f.spec(),
+                    requested,
+                    n,
+                    variance: p.variance,
+                    stderr: (e.sets >= 2).then_some(p.stderr),
+                    method: p.method.to_string(),
+                    radial,
+                });
+                on_cell();
+            }
+            Ok(cells)
+        })
+        .collect();
+    let mut cells = Vec::new();
+    for item in per_item {
+        cells.extend(item?);
     }
     Ok(cells)
 }

@@ -13,6 +13,16 @@ pub enum ExperimentError {
         /// What is wrong.
         reason: String,
     },
+    /// A figure of a figure experiment failed.
+    #[error("{file}: figures[{index}]: {reason}")]
+    Figure {
+        /// The experiment file.
+        file: String,
+        /// The figure's index in the file.
+        index: usize,
+        /// The error.
+        reason: String,
+    },
     /// A computation failed.
     #[error("{file}: {sampler} at N = {n} on {integrand}: {reason}")]
     Cell {
@@ -38,6 +48,10 @@ pub struct Experiment {
     /// A paragraph for the report.
     #[serde(default)]
     pub description: String,
+    /// `variance` when given (the default kind; `figures` is
+    /// [`super::FigureExperiment`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kind: Option<String>,
     /// Sampler names (with `name:key=value` parameters if any).
     pub samplers: Vec<String>,
     /// Integrand specs, all of one dimension.
@@ -50,6 +64,82 @@ pub struct Experiment {
     /// Seed of the realizations.
     #[serde(default)]
     pub seed: u64,
+    /// Also the radial (isotropic) predictor, from the same realizations,
+    /// against the reference form: where a radial average holds and where
+    /// it fails (Pilleboue et al. 2015, §5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radial: Option<RadialComparison>,
+}
+
+/// The radial predictor's box (`"radial": {"half": 255}`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RadialComparison {
+    /// The radial and Fourier forms' box |k|∞ ≤ half.
+    pub half: usize,
+}
+
+/// Most frequencies the radial comparison's box may hold (the spectra of a
+/// cell take 16 bytes each, twice).
+const RADIAL_FREQUENCIES: u64 = 1 << 26;
+
+/// Checks that `name` is a plain file name (the results folder of an
+/// experiment, a figure's file): not empty, `.` or `..`, no `/` or `\\`,
+/// at most 100 bytes.
+pub(super) fn plain_name(name: &str) -> Result<(), String> {
+    let plain = !name.is_empty()
+        && !matches!(name, "." | "..")
+        && !name.contains(['/', '\\', '\0'])
+        && name.len() <= 100;
+    if plain {
+        Ok(())
+    } else {
+        Err(format!(
+            "name `{}` must be a plain file name (no / or \\, not empty, . or .., at most 100 bytes): it names a folder or file of the results",
+            name.escape_debug()
+        ))
+    }
+}
+
+/// An experiment file of either kind.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ExperimentFile {
+    /// Variances of samplers on integrands over N ([`Experiment`]).
+    Variance(Experiment),
+    /// Figures ([`super::FigureExperiment`]).
+    Figures(super::FigureExperiment),
+}
+
+impl ExperimentFile {
+    /// Parses file `file`'s text by its `kind` (absent: `variance`).
+    ///
+    /// # Errors
+    /// As [`Experiment::parse`] and [`super::FigureExperiment::parse`].
+    pub fn parse(text: &str, file: &str) -> Result<Self, ExperimentError> {
+        let kind = serde_json::from_str::<serde_json::Value>(text)
+            .ok()
+            .and_then(|v| v.get("kind").and_then(|k| k.as_str()).map(str::to_owned));
+        match kind.as_deref() {
+            Some("figures") => {
+                super::FigureExperiment::parse(text, file).map(ExperimentFile::Figures)
+            }
+            None | Some("variance") => Experiment::parse(text, file).map(ExperimentFile::Variance),
+            Some(other) => Err(ExperimentError::Invalid {
+                file: file.to_string(),
+                reason: format!(
+                    "kind `{other}`: an experiment's kind is `variance` (the default) or `figures`"
+                ),
+            }),
+        }
+    }
+
+    /// Its name (the default output folder).
+    pub fn name(&self) -> &str {
+        match self {
+            ExperimentFile::Variance(e) => &e.name,
+            ExperimentFile::Figures(e) => &e.name,
+        }
+    }
 }
 
 fn default_sets() -> usize {
@@ -68,14 +158,10 @@ impl Experiment {
         };
         let e: Experiment = serde_json::from_str(text)
             .map_err(|err| invalid(format!("not a valid experiment: {err}")))?;
-        let plain = !e.name.is_empty()
-            && !matches!(e.name.as_str(), "." | "..")
-            && !e.name.contains(['/', '\\', '\0'])
-            && e.name.len() <= 100;
-        if !plain {
+        plain_name(&e.name).map_err(invalid)?;
+        if let Some(kind) = e.kind.as_deref().filter(|k| *k != "variance") {
             return Err(invalid(format!(
-                "name `{}` must be a plain file name (no / or \\, not empty, . or .., at most 100 bytes): it names the results folder",
-                e.name.escape_debug()
+                "kind `{kind}`: an experiment's kind is `variance` (the default) or `figures`"
             )));
         }
         if e.samplers.is_empty() || e.integrands.is_empty() || e.n.is_empty() || e.sets == 0 {
@@ -101,6 +187,17 @@ impl Experiment {
             return Err(invalid(
                 "all integrands of an experiment must have the same dimension".into(),
             ));
+        }
+        if let Some(r) = e.radial {
+            let side = 2 * r.half as u64 + 1;
+            let frequencies = side.checked_pow(dims[0] as u32).unwrap_or(u64::MAX);
+            if r.half == 0 || frequencies > RADIAL_FREQUENCIES {
+                return Err(invalid(format!(
+                    "radial.half = {} must be at least 1 and keep the box within {RADIAL_FREQUENCIES} frequencies \
+                     ({side}^{} = {frequencies} in {}D)",
+                    r.half, dims[0], dims[0]
+                )));
+            }
         }
         for (i, sampler) in e.samplers.iter().enumerate() {
             if e.samplers[..i].contains(sampler) {
