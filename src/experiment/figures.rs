@@ -7,6 +7,7 @@
 //! docs/formats.md, "Figure experiments").
 
 use std::path::Path;
+use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
@@ -18,6 +19,12 @@ use crate::registry;
 use crate::report::plot::{LinePlot, Series, line_plot_png, power_png, spectrum_png};
 use crate::rng::set_rng;
 use crate::samplers::Sampler;
+use crate::scene::Scene;
+use crate::scene::analysis::SampleShear;
+use crate::scene::render::{
+    PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, reference_image,
+    render_variance,
+};
 use crate::spectrum::radial::radial_profile;
 use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power};
 use crate::variance::fourier::integrand_power;
@@ -29,6 +36,23 @@ const MAX_RES: usize = 2048;
 const MAX_SETS: usize = 1 << 20;
 /// The NUFFT tolerance of the figures' spectra.
 const TOLERANCE: f64 = 1e-9;
+/// Most samples per pixel a scene figure may ask for.
+const MAX_SPP: usize = 1 << 16;
+/// Most renders per policy of a scene figure.
+const MAX_RENDERS: usize = 4096;
+/// Stream offsets of the scene figure's reference and of its choice of the
+/// best global shear (independent of the renders it scores).
+const REFERENCE_STREAM: u64 = 0x7e_fe7e;
+const SELECTION_STREAM: u64 = 0x5e_1ec7;
+
+/// The scene figure's shear policies, in table order ("best global" takes
+/// the chosen shear).
+const POLICIES: [(&str, ShearPolicy); 4] = [
+    ("none", ShearPolicy::None),
+    ("best global", ShearPolicy::Global(SampleShear::NONE)),
+    ("per-pixel analytic", ShearPolicy::Analytic),
+    ("per-pixel pilot", ShearPolicy::Pilot { pilots: 8 }),
+];
 
 /// A figure experiment (see the module doc).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
@@ -116,6 +140,31 @@ pub enum Figure {
         /// Box resolution.
         res: usize,
     },
+    /// The depth-of-field scene's per-pixel variance over `renders`
+    /// independent renders with a 4D sampler at each spp, under four shear
+    /// policies: none, the best single global shear (chosen on 2 renders of
+    /// another seed among fixed candidates), the per-pixel analytic warp
+    /// and the per-pixel pilot choice (docs/scene.md). Writes `PREFIX.csv`
+    /// (mean, median and 95th-percentile pixel variance, MSE against a
+    /// reference, seconds), `PREFIX-reference.pfm` (Sobol', 2 renders at
+    /// `reference_spp`) and the seed's variance heat maps at `heatmap_spp`:
+    /// `PREFIX-variance-{none,per-pixel-analytic,per-pixel-pilot}.png`.
+    SceneVariance {
+        /// File name prefix.
+        prefix: String,
+        /// A built-in scene (`dof`) or a scene file.
+        scene: String,
+        /// 4D sampler.
+        sampler: String,
+        /// Samples per pixel (each the sampler's nearest valid N).
+        spp: Vec<usize>,
+        /// Renders per policy and spp (at least 2).
+        renders: usize,
+        /// The spp of the heat maps (one of `spp`).
+        heatmap_spp: usize,
+        /// The reference's spp (Sobol').
+        reference_spp: usize,
+    },
     /// Variance against N of a 4D sampler with (x, y) and (u, v) halves,
     /// before and after the shear (a, b), estimator shifted in (x, y) only
     /// (Singh & Jarosz 2017), with the slopes.
@@ -148,6 +197,13 @@ impl Figure {
                 .collect(),
             Figure::Projections { prefix, planes, .. } => {
                 planes.iter().map(|p| format!("{prefix}-{p}.png")).collect()
+            }
+            Figure::SceneVariance { prefix, .. } => {
+                let mut files = vec![format!("{prefix}.csv"), format!("{prefix}-reference.pfm")];
+                for (name, _) in POLICIES.iter().filter(|p| p.0 != "best global") {
+                    files.push(format!("{prefix}-variance-{}.png", name.replace(' ', "-")));
+                }
+                files
             }
         }
     }
@@ -182,7 +238,7 @@ impl FigureExperiment {
             let at = |reason: String| invalid(format!("figures[{i}]: {reason}"));
             for name in figure.files() {
                 plain_name(&name).map_err(at)?;
-                if !name.ends_with(".png") {
+                if !name.ends_with(".png") && !matches!(figure, Figure::SceneVariance { .. }) {
                     return Err(at(format!("file `{name}` must end in .png")));
                 }
                 if written.contains(&name) {
@@ -202,6 +258,17 @@ impl FigureExperiment {
                     Ok(())
                 }
             };
+            // A spectrum's samplers (in dimension `dim`), sets and box.
+            let spectra = |samplers: &[String], n: usize, dim: usize, sets: usize, res: usize| {
+                if samplers.is_empty() {
+                    return Err(at("samplers must be non-empty".into()));
+                }
+                for s in samplers {
+                    sampler_at(s, n, dim)?;
+                }
+                counted("sets", sets, MAX_SETS)?;
+                counted("res", res, MAX_RES)
+            };
             match figure {
                 Figure::RadialSpectra {
                     samplers,
@@ -209,27 +276,14 @@ impl FigureExperiment {
                     sets,
                     res,
                     ..
-                } => {
-                    if samplers.is_empty() {
-                        return Err(at("samplers must be non-empty".into()));
-                    }
-                    for s in samplers {
-                        sampler_at(s, *n, 2)?;
-                    }
-                    counted("sets", *sets, MAX_SETS)?;
-                    counted("res", *res, MAX_RES)?;
-                }
+                } => spectra(samplers, *n, 2, *sets, *res)?,
                 Figure::Spectrum {
                     sampler,
                     n,
                     sets,
                     res,
                     ..
-                } => {
-                    sampler_at(sampler, *n, 2)?;
-                    counted("sets", *sets, MAX_SETS)?;
-                    counted("res", *res, MAX_RES)?;
-                }
+                } => spectra(std::slice::from_ref(sampler), *n, 2, *sets, *res)?,
                 Figure::Ingredients {
                     sampler,
                     integrand,
@@ -238,13 +292,11 @@ impl FigureExperiment {
                     res,
                     ..
                 } => {
-                    sampler_at(sampler, *n, 2)?;
+                    spectra(std::slice::from_ref(sampler), *n, 2, *sets, *res)?;
                     let f = integrands::parse(integrand).map_err(|err| at(err.to_string()))?;
                     if f.dim() != 2 {
                         return Err(at(format!("integrand `{integrand}` must be 2D")));
                     }
-                    counted("sets", *sets, MAX_SETS)?;
-                    counted("res", *res, MAX_RES)?;
                 }
                 Figure::Projections {
                     sampler,
@@ -255,12 +307,13 @@ impl FigureExperiment {
                     res,
                     ..
                 } => {
-                    let (s, _) = registry::build_nearest(sampler, *n, Some(4), &[])
-                        .map_err(|err| at(format!("sampler `{sampler}` at n = {n}: {err}")))?;
+                    spectra(std::slice::from_ref(sampler), *n, 4, *sets, *res)?;
                     if let Some(shear) = shear {
                         if !shear.iter().all(|a| a.is_finite()) {
                             return Err(at("shear must be finite".into()));
                         }
+                        let (s, _) = registry::build_nearest(sampler, *n, Some(4), &[])
+                            .map_err(|err| at(err.to_string()))?;
                         Sheared::new(s.as_ref(), *shear).map_err(|err| at(err.to_string()))?;
                     }
                     if planes.is_empty() {
@@ -269,8 +322,37 @@ impl FigureExperiment {
                     for p in planes {
                         plane(p).map_err(at)?;
                     }
-                    counted("sets", *sets, MAX_SETS)?;
-                    counted("res", *res, MAX_RES)?;
+                }
+                Figure::SceneVariance {
+                    scene,
+                    sampler,
+                    spp,
+                    renders,
+                    heatmap_spp,
+                    reference_spp,
+                    ..
+                } => {
+                    Scene::load(scene).map_err(|err| at(err.to_string()))?;
+                    if spp.is_empty() {
+                        return Err(at("spp must be non-empty".into()));
+                    }
+                    for &n in spp.iter().chain([heatmap_spp, reference_spp]) {
+                        counted("spp", n, MAX_SPP)?;
+                    }
+                    for &n in spp {
+                        sampler_at(sampler, n, 4)?;
+                    }
+                    if !spp.contains(heatmap_spp) {
+                        return Err(at(format!(
+                            "heatmap_spp = {heatmap_spp} must be one of spp {spp:?}"
+                        )));
+                    }
+                    sampler_at("sobol", *reference_spp, 4)?;
+                    if *renders < 2 || *renders > MAX_RENDERS {
+                        return Err(at(format!(
+                            "renders = {renders} must be in 2 ..= {MAX_RENDERS} (a variance needs two)"
+                        )));
+                    }
                 }
                 Figure::ShearConvergence {
                     sampler,
@@ -320,11 +402,8 @@ impl FigureExperiment {
     ) -> Result<String, ExperimentError> {
         let mut md = format!(
             "# {}\n\n{}\n\nCommand: `cargo run --release -- experiment {file} -o <this folder>` \
-             (realizations seeded {}, shifts {}).\n\n",
-            self.name,
-            self.description,
-            self.seed,
-            self.seed.wrapping_add(1)
+             (seed {}).\n\n",
+            self.name, self.description, self.seed
         );
         for (i, figure) in self.figures.iter().enumerate() {
             let fail = |reason: String| ExperimentError::Figure {
@@ -369,6 +448,140 @@ impl FigureExperiment {
             &|| {},
         )?;
         Ok((spectrum, n))
+    }
+
+    /// [`Figure::SceneVariance`]; returns its README entry.
+    #[allow(clippy::too_many_arguments)]
+    fn scene_variance(
+        &self,
+        out: &Path,
+        prefix: &str,
+        scene: &str,
+        sampler: &str,
+        spp: &[usize],
+        renders: usize,
+        heatmap_spp: usize,
+        reference_spp: usize,
+    ) -> Result<String, Box<dyn std::error::Error>> {
+        let scene = Scene::load(scene)?;
+        let analysis = analyse(&scene);
+        let (sobol, reference_n) = registry::build_nearest("sobol", reference_spp, Some(4), &[])?;
+        let seed = self.seed;
+        let reference = reference_image(&scene, sobol.as_ref(), seed ^ REFERENCE_STREAM)?;
+        reference.write_pfm(&out.join(format!("{prefix}-reference.pfm")))?;
+        let mut candidates = vec![SampleShear::NONE];
+        for k in [-8.0, -6.0, -4.0, -2.0, -1.0, 1.0, 2.0, 4.0, 6.0, 8.0] {
+            candidates.push(SampleShear::Warp(k));
+        }
+        for a in [-1.0, -0.5, 0.5, 1.0] {
+            candidates.push(SampleShear::Position([a, a]));
+        }
+        let mut rows: Vec<Vec<String>> = Vec::new();
+        let mut table = String::from(
+            "| spp | policy | shear | mean variance | median | 95th percentile | MSE vs reference | s |\n\
+             |---|---|---|---|---|---|---|---|\n",
+        );
+        let mut gains = String::new();
+        for &requested in spp {
+            let (s, n) = registry::build_nearest(sampler, requested, Some(4), &[])?;
+            // The best global transformation on 2 renders of another seed.
+            let mut best = (SampleShear::NONE, f64::INFINITY);
+            for &c in &candidates {
+                let shears = vec![c; analysis.len()];
+                let maps = render_variance(
+                    &scene,
+                    s.as_ref(),
+                    &shears,
+                    seed ^ SELECTION_STREAM,
+                    2,
+                    &|| {},
+                )?;
+                let v = PixelStatistics::of(&maps.variance.pixels).mean;
+                if v < best.1 {
+                    best = (c, v);
+                }
+            }
+            let mut means = Vec::new();
+            for &(name, policy) in &POLICIES {
+                let policy = match policy {
+                    ShearPolicy::Global(_) => ShearPolicy::Global(best.0),
+                    p => p,
+                };
+                let clock = Instant::now();
+                let shears = pixel_shears(&scene, s.as_ref(), policy, &analysis, seed)?;
+                let maps = render_variance(&scene, s.as_ref(), &shears, seed, renders, &|| {})?;
+                let seconds = clock.elapsed().as_secs_f64();
+                let mse = mse_against(
+                    &maps.mean.pixels,
+                    Some(&maps.variance.pixels),
+                    renders,
+                    &reference.pixels,
+                );
+                let stats = PixelStatistics::of(&maps.variance.pixels);
+                let label = match policy {
+                    ShearPolicy::Global(c) => format!("{} {}", c.form(), c.amounts()[0]),
+                    ShearPolicy::None => "none".into(),
+                    _ => "per pixel".into(),
+                };
+                table += &format!(
+                    "| {n} | {name} | {label} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} | {seconds:.1} |\n",
+                    stats.mean, stats.median, stats.p95
+                );
+                rows.push(vec![
+                    n.to_string(),
+                    name.into(),
+                    label,
+                    renders.to_string(),
+                    format!("{:e}", stats.mean),
+                    format!("{:e}", stats.median),
+                    format!("{:e}", stats.p95),
+                    format!("{mse:e}"),
+                    format!("{seconds:.2}"),
+                ]);
+                means.push(stats.mean);
+                if requested == heatmap_spp && name != "best global" {
+                    maps.variance.write_variance_png(
+                        &format!(
+                            "{}, {sampler} {n} spp, {name}: per-pixel variance ({renders} renders)",
+                            scene.name()
+                        ),
+                        Some((-6.0, -2.0)),
+                        &out.join(format!("{prefix}-variance-{}.png", name.replace(' ', "-"))),
+                    )?;
+                }
+            }
+            gains += &format!(
+                "- {n} spp: per-pixel analytic {:.2}× below none, {:.2}× below the best global shear; \
+                 pilot {:.2}× below none.\n",
+                means[0] / means[2],
+                means[1] / means[2],
+                means[0] / means[3]
+            );
+        }
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record([
+            "spp",
+            "method",
+            "shear",
+            "renders",
+            "mean_variance",
+            "median_variance",
+            "p95_variance",
+            "mse_vs_reference",
+            "seconds",
+        ])?;
+        for r in &rows {
+            w.write_record(r)?;
+        }
+        let bytes = w.into_inner().map_err(|e| e.to_string())?;
+        write_atomic(&out.join(format!("{prefix}.csv")), |w| w.write_all(&bytes))?;
+        Ok(format!(
+            "- `{prefix}.csv`, `{prefix}-variance-{{none,per-pixel-analytic,per-pixel-pilot}}.png` \
+             (at {heatmap_spp} spp), `{prefix}-reference.pfm` (Sobol' {reference_n} spp, 2 renders): \
+             scene `{}` with {sampler}, per-pixel variance over {renders} renders, MSE against the \
+             reference.\n\n{table}\n{gains}",
+            scene.name()
+        ))
     }
 
     /// Draws one figure; returns its README entry.
@@ -523,6 +736,24 @@ impl FigureExperiment {
                     planes.join(", ")
                 ))
             }
+            Figure::SceneVariance {
+                prefix,
+                scene,
+                sampler,
+                spp,
+                renders,
+                heatmap_spp,
+                reference_spp,
+            } => self.scene_variance(
+                out,
+                prefix,
+                scene,
+                sampler,
+                spp,
+                *renders,
+                *heatmap_spp,
+                *reference_spp,
+            ),
             Figure::ShearConvergence {
                 file,
                 sampler,
@@ -592,11 +823,12 @@ impl FigureExperiment {
                 };
                 line_plot_png(&plot, &out.join(file))?;
                 Ok(format!(
-                    "- `{file}`: {sampler} on `{}`, estimator shifted in (x, y) only, \
-                     {realizations} realizations per N; slope {sb:.2} unsheared, {sa:.2} sheared \
+                    "- `{file}`: {sampler} on `{}`, estimator shifted in (x, y) only (shifts \
+                     seeded {}), {realizations} realizations per N; slope {sb:.2} unsheared, {sa:.2} sheared \
                      by (a, b) = ({}, {}).\n\n\
                      | N | unsheared | sheared | ratio |\n|---|---|---|---|\n{rows}",
                     f.spec(),
+                    self.seed.wrapping_add(1),
                     shear[0],
                     shear[1]
                 ))

@@ -218,6 +218,31 @@ pub struct VarianceMaps {
     pub renders: usize,
 }
 
+/// A reference image: the mean of renders 0 and 1 of `seed` with `sampler`
+/// and no shear (experiments use Owen-scrambled Sobol' at 4096 spp).
+///
+/// # Errors
+/// [`RenderError`].
+pub fn reference_image(
+    scene: &Scene,
+    sampler: &dyn Sampler,
+    seed: u64,
+) -> Result<GreyImage, RenderError> {
+    let [w, h] = scene.camera().resolution();
+    let none = vec![SampleShear::NONE; w * h];
+    let a = render(scene, sampler, &none, seed, 0)?;
+    let b = render(scene, sampler, &none, seed, 1)?;
+    Ok(GreyImage {
+        pixels: a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .map(|(x, y)| 0.5 * (x + y))
+            .collect(),
+        ..a
+    })
+}
+
 /// Renders `renders` times (renders 0 … R−1 of `seed`) and accumulates the
 /// per-pixel mean and variance (Welford's update: no difference of large
 /// sums). `progress` is called once per render.
