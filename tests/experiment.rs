@@ -267,6 +267,16 @@ fn the_seed_figures_experiment_draws_every_figure() {
                 *n = vec![64, 256];
                 *realizations = 400;
             }
+            Figure::DesignedProjections {
+                n,
+                sets,
+                iterations,
+                ..
+            } => {
+                *n = 64;
+                *sets = 2;
+                *iterations = Some(50);
+            }
             Figure::SceneVariance { .. } => unreachable!("not in seed-figures.json"),
         }
     }
@@ -294,7 +304,7 @@ fn the_seed_figures_experiment_draws_every_figure() {
             pngs += 1;
         }
     }
-    assert_eq!(pngs, 13, "{md}");
+    assert_eq!(pngs, 17, "{md}");
     // The shear's table: every row's ratio above 2 (measured 3.5 and 6.7).
     let ratios: Vec<f64> = md
         .lines()
@@ -328,7 +338,7 @@ fn figure_experiments_refuse_what_they_cannot_draw() {
         ),
         (
             text.replace("defocus:shape=disk,size=0.3,c=0.5", "disk:r=0.3"),
-            "figures[6]: integrand `disk:r=0.3` must be 4D",
+            "figures[7]: integrand `disk:r=0.3` must be 4D",
         ),
         (
             text.replace("\"sampler\": \"umj\"", "\"sampler\": \"cmj\""),

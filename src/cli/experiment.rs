@@ -29,8 +29,9 @@ The experiment file is one JSON object (docs/formats.md, \"Experiment file\"):
 Unknown fields are an error. Examples: experiments/rates.json,
 experiments/radial-failure.json.
 With \"kind\": \"figures\" the file lists figures instead (name, description,
-seed, figures: radial-spectra, spectrum, ingredients, shear-convergence;
-docs/formats.md, \"Figure experiments\"), e.g. experiments/seed-figures.json")]
+seed, figures: radial-spectra, spectrum, projections, ingredients,
+designed-projections, scene-variance, shear-convergence; docs/formats.md,
+\"Figure experiments\"), e.g. experiments/seed-figures.json")]
 pub struct Args {
     /// Experiment file (JSON; fields in docs/formats.md): name, description,
     /// samplers, integrands, n, sets, seed, radial.

@@ -12,13 +12,16 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use super::spec::{ExperimentError, plain_name};
+use crate::design::projections::{ProjectionRequest, design_projections};
 use crate::integrands;
 use crate::io::write_atomic;
+use crate::optimize::projections::parse_projections;
 use crate::optimize::shear::Sheared;
+use crate::points::PointSet;
 use crate::registry;
 use crate::report::plot::{LinePlot, Series, line_plot_png, power_png, spectrum_png};
 use crate::rng::set_rng;
-use crate::samplers::Sampler;
+use crate::samplers::{Sampler, SamplerError};
 use crate::scene::Scene;
 use crate::scene::analysis::SampleShear;
 use crate::scene::render::{
@@ -36,6 +39,10 @@ const MAX_RES: usize = 2048;
 const MAX_SETS: usize = 1 << 20;
 /// The NUFFT tolerance of the figures' spectra.
 const TOLERANCE: f64 = 1e-9;
+/// Largest design a figure may ask for: points per set, sets, iterations.
+const MAX_DESIGN_POINTS: usize = 1 << 16;
+const MAX_DESIGN_SETS: usize = 256;
+const MAX_ITERATIONS: usize = 100_000;
 /// Most samples per pixel a scene figure may ask for.
 const MAX_SPP: usize = 1 << 16;
 /// Most renders per policy of a scene figure.
@@ -140,6 +147,27 @@ pub enum Figure {
         /// Box resolution.
         res: usize,
     },
+    /// The seed's design principle: 4D sets designed from umj for a target
+    /// per projection (`xy:SPEC;uv:SPEC;…`, as `optimize points -d 4
+    /// --target`), and the expected spectra of their projections `planes`:
+    /// `PREFIX-PLANE.png`, with each term's loss before and after.
+    DesignedProjections {
+        /// File name prefix.
+        prefix: String,
+        /// The projection target.
+        target: String,
+        /// Points per set.
+        n: usize,
+        /// Sets designed (in parallel).
+        sets: usize,
+        /// Iteration cap (default 1000).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        iterations: Option<usize>,
+        /// Planes among `xy`, `uv`, `xu`, `yv`.
+        planes: Vec<String>,
+        /// Box resolution.
+        res: usize,
+    },
     /// The depth-of-field scene's per-pixel variance over `renders`
     /// independent renders with a 4D sampler at each spp, under four shear
     /// policies: none, the best single global shear (chosen on 2 renders of
@@ -195,7 +223,8 @@ impl Figure {
                 .iter()
                 .map(|p| format!("{prefix}-{p}.png"))
                 .collect(),
-            Figure::Projections { prefix, planes, .. } => {
+            Figure::Projections { prefix, planes, .. }
+            | Figure::DesignedProjections { prefix, planes, .. } => {
                 planes.iter().map(|p| format!("{prefix}-{p}.png")).collect()
             }
             Figure::SceneVariance { prefix, .. } => {
@@ -316,6 +345,30 @@ impl FigureExperiment {
                             .map_err(|err| at(err.to_string()))?;
                         Sheared::new(s.as_ref(), *shear).map_err(|err| at(err.to_string()))?;
                     }
+                    if planes.is_empty() {
+                        return Err(at("planes must be non-empty".into()));
+                    }
+                    for p in planes {
+                        plane(p).map_err(at)?;
+                    }
+                }
+                Figure::DesignedProjections {
+                    target,
+                    n,
+                    sets,
+                    iterations,
+                    planes,
+                    res,
+                    ..
+                } => {
+                    counted("n", *n, MAX_DESIGN_POINTS)?;
+                    sampler_at("umj", *n, 4)?;
+                    parse_projections(target, *n).map_err(|err| at(err.to_string()))?;
+                    counted("sets", *sets, MAX_DESIGN_SETS)?;
+                    if let Some(i) = iterations {
+                        counted("iterations", *i, MAX_ITERATIONS)?;
+                    }
+                    counted("res", *res, MAX_RES)?;
                     if planes.is_empty() {
                         return Err(at("planes must be non-empty".into()));
                     }
@@ -448,6 +501,45 @@ impl FigureExperiment {
             &|| {},
         )?;
         Ok((spectrum, n))
+    }
+
+    /// E[N·P_S] of the projections `planes` of the 4D sets `realization(r)`,
+    /// r < `sets`, as `PREFIX-PLANE.png`.
+    #[allow(clippy::too_many_arguments)]
+    fn plane_pngs(
+        &self,
+        out: &Path,
+        prefix: &str,
+        title: &str,
+        planes: &[String],
+        sets: usize,
+        res: usize,
+        realization: &(dyn Fn(usize) -> Result<PointSet, SamplerError> + Sync),
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        for p in planes {
+            let (dims, axes) = plane(p)?;
+            let spectrum = expected_power(
+                FrequencyBox::from_resolution(2, res),
+                Method::Fast {
+                    tolerance: TOLERANCE,
+                },
+                sets,
+                |r| -> Result<_, VarianceError> {
+                    Ok(realization(r)?
+                        .projected(&dims)
+                        .expect("a plane of a 4D set (checked with the experiment)"))
+                },
+                &|| {},
+            )?;
+            power_png(
+                &spectrum,
+                &format!("{title}: {p} projection ({sets} sets)"),
+                axes,
+                "log10 power (N·P_S)",
+                &out.join(format!("{prefix}-{p}.png")),
+            )?;
+        }
+        Ok(())
     }
 
     /// [`Figure::SceneVariance`]; returns its README entry.
@@ -705,35 +797,62 @@ impl FigureExperiment {
                     Some([a, b]) => format!("{sampler} sheared by (a, b) = ({a}, {b})"),
                     None => sampler.clone(),
                 };
-                for p in planes {
-                    let (dims, axes) = plane(p)?;
-                    let spectrum = expected_power(
-                        FrequencyBox::from_resolution(2, *res),
-                        Method::Fast {
-                            tolerance: TOLERANCE,
-                        },
-                        *sets,
-                        |r| -> Result<_, VarianceError> {
-                            Ok(drawn
-                                .sample(&mut set_rng(self.seed, r as u64))?
-                                .projected(&dims)
-                                .expect("a plane of a 4D sampler's sets (built with d = 4)"))
-                        },
-                        &|| {},
-                    )?;
-                    power_png(
-                        &spectrum,
-                        &format!("{what}, N = {m}: {p} projection ({sets} sets)"),
-                        axes,
-                        "log10 power (N·P_S)",
-                        &out.join(format!("{prefix}-{p}.png")),
-                    )?;
-                }
+                let title = format!("{what}, N = {m}");
+                self.plane_pngs(out, prefix, &title, planes, *sets, *res, &|r| {
+                    drawn.sample(&mut set_rng(self.seed, r as u64))
+                })?;
                 Ok(format!(
                     "- `{prefix}-{{{}}}.png`: E[N·P_S] of the {} projections of {what} at N = {m}, \
                      {sets} sets, box {res}².\n",
                     planes.join(","),
                     planes.join(", ")
+                ))
+            }
+            Figure::DesignedProjections {
+                prefix,
+                target,
+                n,
+                sets,
+                iterations,
+                planes,
+                res,
+            } => {
+                let design = design_projections(
+                    &ProjectionRequest {
+                        n: *n,
+                        target: target.clone(),
+                        sets: *sets,
+                        iters: *iterations,
+                        rel_tol: None,
+                        seed: self.seed,
+                        init: None,
+                    },
+                    &|_, _| {},
+                )?;
+                let title = format!("designed 4D sets, N = {n}");
+                self.plane_pngs(out, prefix, &title, planes, *sets, *res, &|r| {
+                    Ok(design.points[r].clone())
+                })?;
+                let mut terms = String::from(
+                    "| term | weight | loss of the umj starts | loss of the designs |\n|---|---|---|---|\n",
+                );
+                for t in &design.terms {
+                    terms += &format!(
+                        "| `{}` | {} | {:.4e} | {:.4e} |\n",
+                        t.term, t.weight, t.loss_before, t.loss_after
+                    );
+                }
+                Ok(format!(
+                    "- `{prefix}-{{{}}}.png`: E[N·P_S] of the {} projections of {sets} 4D sets of \
+                     N = {n} designed from umj for the projection target `{target}` (the seed's \
+                     design principle: a target spectrum per projection), {} iterations at most, \
+                     {:.1} s on 2 cores; closest pair over the hexagonal spacing: XY {:.2}, UV {:.2}.\n\n{terms}",
+                    planes.join(","),
+                    planes.join(", "),
+                    design.iterations,
+                    design.run.seconds,
+                    design.closest_pair_over_hexagonal.xy,
+                    design.closest_pair_over_hexagonal.uv
                 ))
             }
             Figure::SceneVariance {
