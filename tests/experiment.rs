@@ -281,7 +281,7 @@ fn the_seed_figures_experiment_draws_every_figure() {
         }
     }
     let dir = temp_dir("figures");
-    let md = e.run("seed-figures.json", &dir, &|| {}).unwrap();
+    let md = e.run("seed-figures.json", &dir, &|_, _| {}).unwrap();
     let mut pngs = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let p = entry.unwrap().path();
@@ -370,6 +370,10 @@ fn figure_experiments_refuse_what_they_cannot_draw() {
             "figures[0]: heatmap_spp = 32 must be one of spp [16, 64, 256]",
         ),
         (
+            scene.replace("[16, 64, 256]", "[64, 64, 256]"),
+            "figures[0]: spp 64 and 64 both become N = 64",
+        ),
+        (
             scene.replace("\"renders\": 16", "\"renders\": 1"),
             "figures[0]: renders = 1 must be in 2 ..= 4096",
         ),
@@ -427,7 +431,7 @@ fn the_scene_experiment_writes_its_table_heat_maps_and_reference() {
     *renders = 4;
     *heatmap_spp = 16;
     *reference_spp = 256;
-    let md = e.run("scene-dof.json", &dir, &|| {}).unwrap();
+    let md = e.run("scene-dof.json", &dir, &|_, _| {}).unwrap();
     for name in [
         "dof.csv",
         "dof-reference.pfm",
@@ -451,4 +455,22 @@ fn the_scene_experiment_writes_its_table_heat_maps_and_reference() {
         "no shear {none:e} vs per-pixel analytic {analytic:e}\n{md}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The cells of a variance experiment whose items run in parallel are the
+/// same, bit for bit, on one thread and on several.
+#[test]
+fn cells_are_the_same_on_one_thread_and_on_several() {
+    use varspec::experiment::{Experiment, Shard, run_items};
+    let e = Experiment::parse(SMALL, "small.json").unwrap();
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run_items(&e, "small.json", Shard::ALL, &|| {}).unwrap())
+    };
+    let (one, three) = (run(1), run(3));
+    assert_eq!(one.len(), 3 * 2 * 3);
+    assert_eq!(one, three, "cells differ between 1 and 3 threads");
 }

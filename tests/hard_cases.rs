@@ -263,6 +263,14 @@ fn a_dual_ring_just_beyond_the_box_is_inside_the_error_bar() {
         four.variance,
         s.variance
     );
+    // The dark-shell branch is taken: the bound is the rigorous one,
+    // (N − 1)·T/N, not the shell's estimate of a few T/N.
+    let rigorous = (1024.0 - 1.0) * four.tail;
+    assert!(
+        (four.truncation_bound - rigorous).abs() <= 1e-9 * rigorous,
+        "bound {:e}, expected the rigorous (N − 1)·T/N = {rigorous:e}",
+        four.truncation_bound
+    );
     assert!(
         gap <= four.truncation_bound + s.rounding_bound,
         "Fourier {:e} vs spatial {:e}: gap {gap:e} outside the truncation bound {:e}",

@@ -101,7 +101,8 @@ fn pooled(a: &SpatialEstimate, b: &SpatialEstimate) -> SpatialEstimate {
     let (na, nb) = (a.sets as f64, b.sets as f64);
     let n = na + nb;
     let mean = (na * a.variance + nb * b.variance) / n;
-    // Per-set sample variance from a standard error: s² = stderr²·count.
+    // A group's sum of squared deviations from its standard error:
+    // Σ(v − mean)² = stderr²·count·(count − 1).
     let squares = |e: &SpatialEstimate| e.stderr * e.stderr * e.sets as f64 * (e.sets as f64 - 1.0);
     let delta = a.variance - b.variance;
     let per_set = (squares(a) + squares(b) + na * nb / n * delta * delta) / (n - 1.0);

@@ -25,7 +25,7 @@ The experiment file is one JSON object (docs/formats.md, \"Experiment file\"):
   sets         realizations per (sampler, N), default 16
   seed         seed of the realizations, default 0
   radial       {\"half\": H}: also the radial predictor and the Fourier form on
-               the box |k| <= H, from the same realizations (radial.csv)
+               the box |k|inf <= H, from the same realizations (radial.csv)
 Unknown fields are an error. Examples: experiments/rates.json,
 experiments/radial-failure.json.
 With \"kind\": \"figures\" the file lists figures instead (name, description,
@@ -75,7 +75,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             let bar = progress::bar(e.figures.len() as u64, &e.name);
             std::fs::create_dir_all(&out)
                 .with_context(|| format!("{file}: cannot create {}", out.display()))?;
-            let md = e.run(&file, &out, &|| bar.inc(1))?;
+            varspec::experiment::remove_variance_runs(&out)?;
+            let md = e.run(&file, &out, &|i, seconds| {
+                bar.inc(1);
+                bar.suspend(|| eprintln!("figures[{i}]: {seconds:.1} s"));
+            })?;
             bar.finish_and_clear();
             print!("{md}");
             println!("wrote {}", out.display());

@@ -11,6 +11,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use super::report::write_csv;
 use super::spec::{ExperimentError, plain_name};
 use crate::design::projections::{ProjectionRequest, design_projections};
 use crate::integrands;
@@ -174,7 +175,7 @@ pub enum Figure {
     /// another seed among fixed candidates), the per-pixel analytic warp
     /// and the per-pixel pilot choice (docs/scene.md). Writes `PREFIX.csv`
     /// (mean, median and 95th-percentile pixel variance, MSE against a
-    /// reference, seconds), `PREFIX-reference.pfm` (Sobol', 2 renders at
+    /// reference), `PREFIX-reference.pfm` (Sobol', 2 renders at
     /// `reference_spp`) and the seed's variance heat maps at `heatmap_spp`:
     /// `PREFIX-variance-{none,per-pixel-analytic,per-pixel-pilot}.png`.
     SceneVariance {
@@ -298,6 +299,36 @@ impl FigureExperiment {
                 counted("sets", sets, MAX_SETS)?;
                 counted("res", res, MAX_RES)
             };
+            // Projection planes: non-empty, each one of xy, uv, xu, yv.
+            let planes_ok = |planes: &[String]| {
+                if planes.is_empty() {
+                    return Err(at("planes must be non-empty".into()));
+                }
+                planes
+                    .iter()
+                    .try_for_each(|p| plane(p).map(|_| ()).map_err(at))
+            };
+            // A finite shear that `sampler` at N = n can take.
+            let shear_ok = |sampler: &str, n: usize, shear: [f64; 2]| {
+                if !shear.iter().all(|a| a.is_finite()) {
+                    return Err(at("shear must be finite".into()));
+                }
+                let (s, used) = registry::build_nearest(sampler, n, Some(4), &[])
+                    .map_err(|err| at(format!("sampler `{sampler}` at n = {n}: {err}")))?;
+                Sheared::new(s.as_ref(), shear).map_err(|err| at(err.to_string()))?;
+                Ok(used)
+            };
+            // Sizes that stay distinct after each becomes its nearest valid N.
+            let distinct = |what: &str, used: &[(usize, usize)]| {
+                for (i, &(requested, n)) in used.iter().enumerate() {
+                    if let Some(&(earlier, _)) = used[..i].iter().find(|u| u.1 == n) {
+                        return Err(at(format!(
+                            "{what} {earlier} and {requested} both become N = {n}: give values that stay distinct"
+                        )));
+                    }
+                }
+                Ok(())
+            };
             match figure {
                 Figure::RadialSpectra {
                     samplers,
@@ -323,8 +354,10 @@ impl FigureExperiment {
                 } => {
                     spectra(std::slice::from_ref(sampler), *n, 2, *sets, *res)?;
                     let f = integrands::parse(integrand).map_err(|err| at(err.to_string()))?;
-                    if f.dim() != 2 {
-                        return Err(at(format!("integrand `{integrand}` must be 2D")));
+                    if f.dim() != 2 || !f.has_fourier() {
+                        return Err(at(format!(
+                            "integrand `{integrand}` must be 2D with a Fourier transform"
+                        )));
                     }
                 }
                 Figure::Projections {
@@ -338,19 +371,9 @@ impl FigureExperiment {
                 } => {
                     spectra(std::slice::from_ref(sampler), *n, 4, *sets, *res)?;
                     if let Some(shear) = shear {
-                        if !shear.iter().all(|a| a.is_finite()) {
-                            return Err(at("shear must be finite".into()));
-                        }
-                        let (s, _) = registry::build_nearest(sampler, *n, Some(4), &[])
-                            .map_err(|err| at(err.to_string()))?;
-                        Sheared::new(s.as_ref(), *shear).map_err(|err| at(err.to_string()))?;
+                        shear_ok(sampler, *n, *shear)?;
                     }
-                    if planes.is_empty() {
-                        return Err(at("planes must be non-empty".into()));
-                    }
-                    for p in planes {
-                        plane(p).map_err(at)?;
-                    }
+                    planes_ok(planes)?;
                 }
                 Figure::DesignedProjections {
                     target,
@@ -362,19 +385,16 @@ impl FigureExperiment {
                     ..
                 } => {
                     counted("n", *n, MAX_DESIGN_POINTS)?;
-                    sampler_at("umj", *n, 4)?;
+                    // The design starts from umj at exactly N.
+                    registry::build("umj", *n, Some(4), &[])
+                        .map_err(|err| at(format!("the umj start at n = {n}: {err}")))?;
                     parse_projections(target, *n).map_err(|err| at(err.to_string()))?;
                     counted("sets", *sets, MAX_DESIGN_SETS)?;
                     if let Some(i) = iterations {
                         counted("iterations", *i, MAX_ITERATIONS)?;
                     }
                     counted("res", *res, MAX_RES)?;
-                    if planes.is_empty() {
-                        return Err(at("planes must be non-empty".into()));
-                    }
-                    for p in planes {
-                        plane(p).map_err(at)?;
-                    }
+                    planes_ok(planes)?;
                 }
                 Figure::SceneVariance {
                     scene,
@@ -392,9 +412,13 @@ impl FigureExperiment {
                     for &n in spp.iter().chain([heatmap_spp, reference_spp]) {
                         counted("spp", n, MAX_SPP)?;
                     }
+                    let mut used = Vec::new();
                     for &n in spp {
-                        sampler_at(sampler, n, 4)?;
+                        let (_, m) = registry::build_nearest(sampler, n, Some(4), &[])
+                            .map_err(|err| at(format!("sampler `{sampler}` at n = {n}: {err}")))?;
+                        used.push((n, m));
                     }
+                    distinct("spp", &used)?;
                     if !spp.contains(heatmap_spp) {
                         return Err(at(format!(
                             "heatmap_spp = {heatmap_spp} must be one of spp {spp:?}"
@@ -419,20 +443,13 @@ impl FigureExperiment {
                     if f.dim() != 4 {
                         return Err(at(format!("integrand `{integrand}` must be 4D")));
                     }
-                    if !shear.iter().all(|a| a.is_finite()) {
-                        return Err(at("shear must be finite".into()));
-                    }
                     let mut used = Vec::new();
                     for &m in n {
-                        let (s, m) = registry::build_nearest(sampler, m, Some(4), &[])
-                            .map_err(|err| at(format!("sampler `{sampler}` at n = {m}: {err}")))?;
-                        Sheared::new(s.as_ref(), *shear).map_err(|err| at(err.to_string()))?;
-                        if !used.contains(&m) {
-                            used.push(m);
-                        }
+                        used.push((m, shear_ok(sampler, m, *shear)?));
                     }
+                    distinct("n", &used)?;
                     if used.len() < 2 {
-                        return Err(at("n must hold at least two distinct N for a slope".into()));
+                        return Err(at("n must hold at least two N for a slope".into()));
                     }
                     counted("realizations", *realizations, MAX_SETS)?;
                 }
@@ -442,8 +459,9 @@ impl FigureExperiment {
     }
 
     /// Draws every figure into `out` (which must exist) and writes its
-    /// `README.md`; returns the README's text. `on_figure` is called after
-    /// each figure.
+    /// `README.md`; returns the README's text. `on_figure(index, seconds)`
+    /// is called after each figure with its wall time, which the files do
+    /// not hold (they are the same for any thread count and machine).
     ///
     /// # Errors
     /// [`ExperimentError::Figure`] naming the figure that failed.
@@ -451,7 +469,7 @@ impl FigureExperiment {
         &self,
         file: &str,
         out: &Path,
-        on_figure: &dyn Fn(),
+        on_figure: &dyn Fn(usize, f64),
     ) -> Result<String, ExperimentError> {
         let mut md = format!(
             "# {}\n\n{}\n\nCommand: `cargo run --release -- experiment {file} -o <this folder>` \
@@ -464,11 +482,12 @@ impl FigureExperiment {
                 index: i,
                 reason,
             };
+            let clock = Instant::now();
             md += &self
                 .draw(figure, out)
                 .map_err(|err| fail(err.to_string()))?;
             md += "\n";
-            on_figure();
+            on_figure(i, clock.elapsed().as_secs_f64());
         }
         write_atomic(&out.join("README.md"), |w| w.write_all(md.as_bytes())).map_err(|err| {
             ExperimentError::Invalid {
@@ -570,8 +589,8 @@ impl FigureExperiment {
         }
         let mut rows: Vec<Vec<String>> = Vec::new();
         let mut table = String::from(
-            "| spp | policy | shear | mean variance | median | 95th percentile | MSE vs reference | s |\n\
-             |---|---|---|---|---|---|---|---|\n",
+            "| spp | policy | shear | mean variance | median | 95th percentile | MSE vs reference |\n\
+             |---|---|---|---|---|---|---|\n",
         );
         let mut gains = String::new();
         for &requested in spp {
@@ -599,10 +618,8 @@ impl FigureExperiment {
                     ShearPolicy::Global(_) => ShearPolicy::Global(best.0),
                     p => p,
                 };
-                let clock = Instant::now();
                 let shears = pixel_shears(&scene, s.as_ref(), policy, &analysis, seed)?;
                 let maps = render_variance(&scene, s.as_ref(), &shears, seed, renders, &|| {})?;
-                let seconds = clock.elapsed().as_secs_f64();
                 let mse = mse_against(
                     &maps.mean.pixels,
                     Some(&maps.variance.pixels),
@@ -616,7 +633,7 @@ impl FigureExperiment {
                     _ => "per pixel".into(),
                 };
                 table += &format!(
-                    "| {n} | {name} | {label} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} | {seconds:.1} |\n",
+                    "| {n} | {name} | {label} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} |\n",
                     stats.mean, stats.median, stats.p95
                 );
                 rows.push(vec![
@@ -628,7 +645,6 @@ impl FigureExperiment {
                     format!("{:e}", stats.median),
                     format!("{:e}", stats.p95),
                     format!("{mse:e}"),
-                    format!("{seconds:.2}"),
                 ]);
                 means.push(stats.mean);
                 if requested == heatmap_spp && name != "best global" {
@@ -650,23 +666,26 @@ impl FigureExperiment {
                 means[0] / means[3]
             );
         }
-        let mut w = csv::Writer::from_writer(Vec::new());
-        w.write_record([
-            "spp",
-            "method",
-            "shear",
-            "renders",
-            "mean_variance",
-            "median_variance",
-            "p95_variance",
-            "mse_vs_reference",
-            "seconds",
-        ])?;
-        for r in &rows {
-            w.write_record(r)?;
-        }
-        let bytes = w.into_inner().map_err(|e| e.to_string())?;
-        write_atomic(&out.join(format!("{prefix}.csv")), |w| w.write_all(&bytes))?;
+        let name = format!("{prefix}.csv");
+        write_csv(
+            out,
+            &name,
+            &[
+                "spp",
+                "method",
+                "shear",
+                "renders",
+                "mean_variance",
+                "median_variance",
+                "p95_variance",
+                "mse_vs_reference",
+            ],
+            &rows,
+            &|what, err| ExperimentError::Invalid {
+                file: what.to_string(),
+                reason: err,
+            },
+        )?;
         Ok(format!(
             "- `{prefix}.csv`, `{prefix}-variance-{{none,per-pixel-analytic,per-pixel-pilot}}.png` \
              (at {heatmap_spp} spp), `{prefix}-reference.pfm` (Sobol' {reference_n} spp, 2 renders): \
@@ -761,14 +780,18 @@ impl FigureExperiment {
                     &format!("sampling power spectrum E[N·P_S], {sampler} N = {m}"),
                     &out.join(format!("{prefix}-sampling.png")),
                 )?;
-                spectrum_png(
+                power_png(
                     &as_spectrum(pf),
                     &format!("integrand power spectrum P_f, {}", f.spec()),
+                    ["kx", "ky"],
+                    "log10 P_f",
                     &out.join(format!("{prefix}-integrand.png")),
                 )?;
-                spectrum_png(
+                power_png(
                     &as_spectrum(product),
                     "their product E[N·P_S]·P_f (sums to N·Var)",
+                    ["kx", "ky"],
+                    "log10 E[N·P_S]·P_f",
                     &out.join(format!("{prefix}-product.png")),
                 )?;
                 Ok(format!(
@@ -845,12 +868,11 @@ impl FigureExperiment {
                 Ok(format!(
                     "- `{prefix}-{{{}}}.png`: E[N·P_S] of the {} projections of {sets} 4D sets of \
                      N = {n} designed from umj for the projection target `{target}` (the seed's \
-                     design principle: a target spectrum per projection), {} iterations at most, \
-                     {:.1} s on 2 cores; closest pair over the hexagonal spacing: XY {:.2}, UV {:.2}.\n\n{terms}",
+                     design principle: a target spectrum per projection), {} iterations at most; \
+                     closest pair over the hexagonal spacing: XY {:.2}, UV {:.2}.\n\n{terms}",
                     planes.join(","),
                     planes.join(", "),
                     design.iterations,
-                    design.run.seconds,
                     design.closest_pair_over_hexagonal.xy,
                     design.closest_pair_over_hexagonal.uv
                 ))
@@ -886,9 +908,6 @@ impl FigureExperiment {
                 let mut rows = String::new();
                 for &requested in n {
                     let (s, m) = registry::build_nearest(sampler, requested, Some(4), &[])?;
-                    if before.iter().any(|&(x, _)| x == m as f64) {
-                        continue;
-                    }
                     let sheared = Sheared::new(s.as_ref(), *shear)?;
                     let measure = |s: &dyn Sampler| {
                         empirical_shifting(

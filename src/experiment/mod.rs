@@ -15,6 +15,6 @@ mod spec;
 
 pub use figures::{Figure, FigureExperiment};
 
-pub use report::{remove_other_runs, write_results};
+pub use report::{remove_other_runs, remove_variance_runs, write_results};
 pub use run::{Cell, RadialCell, Shard, ShardFile, merge_shards, run_items};
 pub use spec::{Experiment, ExperimentError, ExperimentFile, RadialComparison};

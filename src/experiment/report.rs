@@ -320,6 +320,27 @@ pub fn remove_other_runs(out: &Path, shard: Option<Shard>) -> Result<(), Experim
     Ok(())
 }
 
+/// Removes every table and shard a variance run left in `out`, before a
+/// figure experiment writes its own README.md there (a figure run never
+/// leaves a folder mixing the two kinds; its own earlier PNGs are
+/// overwritten or, for a figure since removed from the file, left).
+///
+/// # Errors
+/// The first file that could not be removed.
+pub fn remove_variance_runs(out: &Path) -> Result<(), ExperimentError> {
+    remove_other_runs(out, None)?;
+    for name in TABLES {
+        let path = out.join(name);
+        if path.exists() {
+            std::fs::remove_file(&path).map_err(|err| ExperimentError::Invalid {
+                file: out.display().to_string(),
+                reason: format!("removing the earlier run's {name}: {err}"),
+            })?;
+        }
+    }
+    Ok(())
+}
+
 /// The files a whole run (or `merge`) writes.
 const TABLES: [&str; 5] = [
     "README.md",
@@ -331,7 +352,7 @@ const TABLES: [&str; 5] = [
 
 /// Writes `rows` under `header` to `out/name` through the csv crate,
 /// atomically.
-fn write_csv(
+pub(super) fn write_csv(
     out: &Path,
     name: &str,
     header: &[&str],

@@ -167,6 +167,7 @@ pub fn run_items(
         .filter(|&(item, _)| shard.owns(item))
         .map(|(_, sn)| sn)
         .collect();
+    check_memory(e, file, owned.len())?;
     let per_item: Vec<Result<Vec<Cell>, ExperimentError>> = owned
         .into_par_iter()
         .map(|(si, ni)| {
@@ -228,6 +229,46 @@ pub fn run_items(
         cells.extend(item?);
     }
     Ok(cells)
+}
+
+/// Items run concurrently, each checking its own allocations against the
+/// same free memory: the budget must hold as many items at once as rayon
+/// runs (its threads, at most `items`), each with its sets at the largest N
+/// and, with the radial comparison, a plan and the spectra of its box.
+fn check_memory(e: &Experiment, file: &str, items: usize) -> Result<(), ExperimentError> {
+    let at_once = rayon::current_num_threads().min(items).max(1) as f64;
+    let dim = e.dim();
+    let largest = e
+        .samplers
+        .iter()
+        .flat_map(|s| {
+            e.n.iter().map(move |&n| {
+                registry::build_nearest(s, n, Some(dim), &[]).map_or(n, |(_, used)| used)
+            })
+        })
+        .max()
+        .unwrap_or(0) as f64;
+    let sets = e.sets as f64 * largest * dim as f64 * 8.0;
+    let radial = match e.radial {
+        None => Some(0.0),
+        Some(r) => {
+            let freqs = crate::spectrum::FrequencyBox { dim, half: r.half };
+            // The plan, and per frequency the mean power, P_f, the ring
+            // index and a shell entry (8 bytes each).
+            crate::spectrum::nufft::nufft_memory_bytes(&freqs)
+                .zip(freqs.checked_len())
+                .map(|(plan, len)| plan + 32.0 * len as f64)
+        }
+    };
+    crate::memory::check(
+        &format!("{} experiment items at once", at_once as usize),
+        radial.map(|r| at_once * (sets + r)),
+        "lower radial.half, n or sets, or run fewer threads (RAYON_NUM_THREADS)",
+    )
+    .map_err(|err| ExperimentError::Invalid {
+        file: file.to_string(),
+        reason: err.to_string(),
+    })
 }
 
 /// The cells of a complete set of shards of one experiment, in the single

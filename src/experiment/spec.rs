@@ -161,7 +161,8 @@ impl Experiment {
         plain_name(&e.name).map_err(invalid)?;
         if let Some(kind) = e.kind.as_deref().filter(|k| *k != "variance") {
             return Err(invalid(format!(
-                "kind `{kind}`: an experiment's kind is `variance` (the default) or `figures`"
+                "kind `{kind}`: this reads variance experiments (kind `variance`, the default); \
+                 ExperimentFile::parse reads either kind"
             )));
         }
         if e.samplers.is_empty() || e.integrands.is_empty() || e.n.is_empty() || e.sets == 0 {
@@ -189,6 +190,15 @@ impl Experiment {
             ));
         }
         if let Some(r) = e.radial {
+            if let Some(spec) = e
+                .integrands
+                .iter()
+                .find(|s| crate::integrands::parse(s).is_ok_and(|f| !f.has_fourier()))
+            {
+                return Err(invalid(format!(
+                    "radial: integrand `{spec}` has no Fourier transform, which the radial and Fourier forms need"
+                )));
+            }
             let side = 2 * r.half as u64 + 1;
             let frequencies = side.checked_pow(dims[0] as u32).unwrap_or(u64::MAX);
             if r.half == 0 || frequencies > RADIAL_FREQUENCIES {
