@@ -140,10 +140,10 @@ pub struct ShardFile {
     pub cells: Vec<Cell>,
 }
 
-/// Runs the items of `shard`, two or more at a time on rayon's pool (each
-/// item's realizations and cells depend only on the item, so the cells,
-/// returned in item order, are the same for any thread count); `on_cell`
-/// is called per cell.
+/// Runs the items of `shard` in parallel, as many at a time as rayon's pool
+/// has threads (each item's realizations and cells depend only on the item,
+/// so the cells, returned in item order, are the same for any thread
+/// count); `on_cell` is called per cell.
 ///
 /// # Errors
 /// [`ExperimentError::Cell`] naming the sampler, N and integrand that failed
