@@ -242,7 +242,8 @@ impl Figure {
 impl FigureExperiment {
     /// Parses and validates the text of file `file`: every sampler and
     /// integrand exists in its dimension, sizes are bounded, file names are
-    /// plain `.png` names written once.
+    /// plain names written once (`.png`, but for the scene figure's table
+    /// and reference).
     ///
     /// # Errors
     /// [`ExperimentError::Invalid`] naming the file, the figure and the rule.
