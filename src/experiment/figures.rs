@@ -11,24 +11,22 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::report::write_csv;
+use super::planes::{TOLERANCE, plane, plane_pngs};
+use super::scene_figures::{
+    MAX_RENDERS, MAX_SPP, POLICIES, REFERENCE_SAMPLER, pixel_files, scene_pixels, scene_samplers,
+    scene_variance,
+};
 use super::spec::{ExperimentError, plain_name};
 use crate::design::projections::{ProjectionRequest, design_projections};
 use crate::integrands;
 use crate::io::write_atomic;
 use crate::optimize::projections::parse_projections;
 use crate::optimize::shear::Sheared;
-use crate::points::PointSet;
 use crate::registry;
 use crate::report::plot::{LinePlot, Series, line_plot_png, power_png, spectrum_png};
 use crate::rng::set_rng;
-use crate::samplers::{Sampler, SamplerError};
+use crate::samplers::Sampler;
 use crate::scene::Scene;
-use crate::scene::analysis::SampleShear;
-use crate::scene::render::{
-    PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, reference_image,
-    render_variance,
-};
 use crate::spectrum::radial::radial_profile;
 use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power};
 use crate::variance::fourier::integrand_power;
@@ -38,29 +36,10 @@ use crate::variance::{VarianceError, empirical_shifting, fit_slope};
 const MAX_RES: usize = 2048;
 /// Most realizations a figure may ask for.
 const MAX_SETS: usize = 1 << 20;
-/// The NUFFT tolerance of the figures' spectra.
-const TOLERANCE: f64 = 1e-9;
 /// Largest design a figure may ask for: points per set, sets, iterations.
 const MAX_DESIGN_POINTS: usize = 1 << 16;
 const MAX_DESIGN_SETS: usize = 256;
 const MAX_ITERATIONS: usize = 100_000;
-/// Most samples per pixel a scene figure may ask for.
-const MAX_SPP: usize = 1 << 16;
-/// Most renders per policy of a scene figure.
-const MAX_RENDERS: usize = 4096;
-/// Stream offsets of the scene figure's reference and of its choice of the
-/// best global shear (independent of the renders it scores).
-const REFERENCE_STREAM: u64 = 0x7e_fe7e;
-const SELECTION_STREAM: u64 = 0x5e_1ec7;
-
-/// The scene figure's shear policies, in table order ("best global" takes
-/// the chosen shear).
-const POLICIES: [(&str, ShearPolicy); 4] = [
-    ("none", ShearPolicy::None),
-    ("best global", ShearPolicy::Global(SampleShear::NONE)),
-    ("per-pixel analytic", ShearPolicy::Analytic),
-    ("per-pixel pilot", ShearPolicy::Pilot { pilots: 8 }),
-];
 
 /// A figure experiment (see the module doc).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
@@ -175,7 +154,7 @@ pub enum Figure {
     /// another seed among fixed candidates), the per-pixel analytic warp
     /// and the per-pixel pilot choice (docs/scene.md). Writes `PREFIX.csv`
     /// (mean, median and 95th-percentile pixel variance, MSE against a
-    /// reference), `PREFIX-reference.pfm` (Sobol', 2 renders at
+    /// reference), `PREFIX-reference.pfm` (hash-scrambled Sobol', 2 renders at
     /// `reference_spp`) and the seed's variance heat maps at `heatmap_spp`:
     /// `PREFIX-variance-{none,per-pixel-analytic,per-pixel-pilot}.png`.
     SceneVariance {
@@ -191,8 +170,49 @@ pub enum Figure {
         renders: usize,
         /// The spp of the heat maps (one of `spp`).
         heatmap_spp: usize,
-        /// The reference's spp (Sobol').
+        /// The reference's spp (hash-scrambled Sobol').
         reference_spp: usize,
+    },
+    /// The seed's soft-shadow table: 4D samplers on scenes (lights) at one
+    /// spp, no shear: mean per-pixel variance over `renders` renders and
+    /// the relative RMS error against a hash-scrambled Sobol' reference (2 renders at
+    /// `reference_spp`) of each scene, written to `file` (a `.csv`).
+    SceneSamplers {
+        /// CSV file name.
+        file: String,
+        /// Built-in scenes or scene files.
+        scenes: Vec<String>,
+        /// 4D samplers.
+        samplers: Vec<String>,
+        /// Samples per pixel (each sampler's nearest valid N).
+        spp: usize,
+        /// Renders per sampler and scene (at least 2).
+        renders: usize,
+        /// The reference's spp (hash-scrambled Sobol').
+        reference_spp: usize,
+    },
+    /// Single pixels of a scene as integrands: the light field's power on
+    /// the XU and YV planes, the transformation the pixel's measured shear
+    /// search chooses, variance before and after, and the sets' spectra
+    /// before and after it (`PREFIX.csv`,
+    /// `PREFIX-X-Y-{f,before,after}-{xu,yv}.png`): the seed's hairline and
+    /// double-wedge pixels.
+    ScenePixels {
+        /// File name prefix.
+        prefix: String,
+        /// A built-in scene or a scene file.
+        scene: String,
+        /// 4D sampler.
+        sampler: String,
+        /// Samples per pixel (the sampler's nearest valid N).
+        n: usize,
+        /// Pixels (x, y), each inside the image, each once (its files are
+        /// written once).
+        pixels: Vec<[usize; 2]>,
+        /// Realizations of the spectra before and after.
+        sets: usize,
+        /// Box resolution of the spectra and the light field's grid (≥ 8).
+        res: usize,
     },
     /// Variance against N of a 4D sampler with (x, y) and (u, v) halves,
     /// before and after the shear (a, b), estimator shifted in (x, y) only
@@ -235,7 +255,20 @@ impl Figure {
                 }
                 files
             }
+            Figure::SceneSamplers { file, .. } => vec![file.clone()],
+            Figure::ScenePixels { prefix, pixels, .. } => pixel_files(prefix, pixels),
         }
+    }
+
+    /// It writes tables (and, for the scene variance, a float image)
+    /// beside its PNGs.
+    fn writes_tables(&self) -> bool {
+        matches!(
+            self,
+            Figure::SceneVariance { .. }
+                | Figure::SceneSamplers { .. }
+                | Figure::ScenePixels { .. }
+        )
     }
 }
 
@@ -269,7 +302,7 @@ impl FigureExperiment {
             let at = |reason: String| invalid(format!("figures[{i}]: {reason}"));
             for name in figure.files() {
                 plain_name(&name).map_err(at)?;
-                if !name.ends_with(".png") && !matches!(figure, Figure::SceneVariance { .. }) {
+                if !name.ends_with(".png") && !figure.writes_tables() {
                     return Err(at(format!("file `{name}` must end in .png")));
                 }
                 if written.contains(&name) {
@@ -318,6 +351,16 @@ impl FigureExperiment {
                     .map_err(|err| at(format!("sampler `{sampler}` at n = {n}: {err}")))?;
                 Sheared::new(s.as_ref(), shear).map_err(|err| at(err.to_string()))?;
                 Ok(used)
+            };
+            // Renders of a per-pixel variance.
+            let renders_ok = |renders: usize| {
+                if !(2..=MAX_RENDERS).contains(&renders) {
+                    Err(at(format!(
+                        "renders = {renders} must be in 2 ..= {MAX_RENDERS} (a variance needs two)"
+                    )))
+                } else {
+                    Ok(())
+                }
             };
             // Sizes that stay distinct after each becomes its nearest valid N.
             let distinct = |what: &str, used: &[(usize, usize)]| {
@@ -425,11 +468,61 @@ impl FigureExperiment {
                             "heatmap_spp = {heatmap_spp} must be one of spp {spp:?}"
                         )));
                     }
-                    sampler_at("sobol", *reference_spp, 4)?;
-                    if *renders < 2 || *renders > MAX_RENDERS {
-                        return Err(at(format!(
-                            "renders = {renders} must be in 2 ..= {MAX_RENDERS} (a variance needs two)"
-                        )));
+                    sampler_at(REFERENCE_SAMPLER, *reference_spp, 4)?;
+                    renders_ok(*renders)?;
+                }
+                Figure::SceneSamplers {
+                    file,
+                    scenes,
+                    samplers,
+                    spp,
+                    renders,
+                    reference_spp,
+                } => {
+                    if !file.ends_with(".csv") {
+                        return Err(at(format!("file `{file}` must end in .csv")));
+                    }
+                    if scenes.is_empty() || samplers.is_empty() {
+                        return Err(at("scenes and samplers must be non-empty".into()));
+                    }
+                    for scene in scenes {
+                        Scene::load(scene).map_err(|err| at(err.to_string()))?;
+                    }
+                    counted("spp", *spp, MAX_SPP)?;
+                    counted("reference_spp", *reference_spp, MAX_SPP)?;
+                    for s in samplers {
+                        sampler_at(s, *spp, 4)?;
+                    }
+                    sampler_at(REFERENCE_SAMPLER, *reference_spp, 4)?;
+                    renders_ok(*renders)?;
+                }
+                Figure::ScenePixels {
+                    scene,
+                    sampler,
+                    n,
+                    pixels,
+                    sets,
+                    res,
+                    ..
+                } => {
+                    let loaded = Scene::load(scene).map_err(|err| at(err.to_string()))?;
+                    let [w, h] = loaded.camera().resolution();
+                    if pixels.is_empty() {
+                        return Err(at("pixels must be non-empty".into()));
+                    }
+                    // (A pixel given twice writes its files twice: refused above.)
+                    for p in pixels {
+                        if p[0] >= w || p[1] >= h {
+                            return Err(at(format!(
+                                "pixel {p:?} is outside the {w}x{h} image of `{scene}`"
+                            )));
+                        }
+                    }
+                    counted("n", *n, MAX_SPP)?;
+                    sampler_at(sampler, *n, 4)?;
+                    counted("sets", *sets, MAX_SETS)?;
+                    if *res < 8 || *res > MAX_RES {
+                        return Err(at(format!("res = {res} must be in 8 ..= {MAX_RES}")));
                     }
                 }
                 Figure::ShearConvergence {
@@ -521,179 +614,6 @@ impl FigureExperiment {
             &|| {},
         )?;
         Ok((spectrum, n))
-    }
-
-    /// E[N·P_S] of the projections `planes` of the 4D sets `realization(r)`,
-    /// r < `sets`, as `PREFIX-PLANE.png`.
-    #[allow(clippy::too_many_arguments)]
-    fn plane_pngs(
-        &self,
-        out: &Path,
-        prefix: &str,
-        title: &str,
-        planes: &[String],
-        sets: usize,
-        res: usize,
-        realization: &(dyn Fn(usize) -> Result<PointSet, SamplerError> + Sync),
-    ) -> Result<(), Box<dyn std::error::Error>> {
-        for p in planes {
-            let (dims, axes) = plane(p)?;
-            let spectrum = expected_power(
-                FrequencyBox::from_resolution(2, res),
-                Method::Fast {
-                    tolerance: TOLERANCE,
-                },
-                sets,
-                |r| -> Result<_, VarianceError> {
-                    Ok(realization(r)?
-                        .projected(&dims)
-                        .expect("a plane of a 4D set (checked with the experiment)"))
-                },
-                &|| {},
-            )?;
-            power_png(
-                &spectrum,
-                &format!("{title}: {p} projection ({sets} sets)"),
-                axes,
-                "log10 power (N·P_S)",
-                &out.join(format!("{prefix}-{p}.png")),
-            )?;
-        }
-        Ok(())
-    }
-
-    /// [`Figure::SceneVariance`]; returns its README entry.
-    #[allow(clippy::too_many_arguments)]
-    fn scene_variance(
-        &self,
-        out: &Path,
-        prefix: &str,
-        scene: &str,
-        sampler: &str,
-        spp: &[usize],
-        renders: usize,
-        heatmap_spp: usize,
-        reference_spp: usize,
-    ) -> Result<String, Box<dyn std::error::Error>> {
-        let scene = Scene::load(scene)?;
-        let analysis = analyse(&scene);
-        let (sobol, reference_n) = registry::build_nearest("sobol", reference_spp, Some(4), &[])?;
-        let seed = self.seed;
-        let reference = reference_image(&scene, sobol.as_ref(), seed ^ REFERENCE_STREAM)?;
-        reference.write_pfm(&out.join(format!("{prefix}-reference.pfm")))?;
-        let mut candidates = vec![SampleShear::NONE];
-        for k in [-8.0, -6.0, -4.0, -2.0, -1.0, 1.0, 2.0, 4.0, 6.0, 8.0] {
-            candidates.push(SampleShear::Warp(k));
-        }
-        for a in [-1.0, -0.5, 0.5, 1.0] {
-            candidates.push(SampleShear::Position([a, a]));
-        }
-        let mut rows: Vec<Vec<String>> = Vec::new();
-        let mut table = String::from(
-            "| spp | policy | shear | mean variance | median | 95th percentile | MSE vs reference |\n\
-             |---|---|---|---|---|---|---|\n",
-        );
-        let mut gains = String::new();
-        for &requested in spp {
-            let (s, n) = registry::build_nearest(sampler, requested, Some(4), &[])?;
-            // The best global transformation on 2 renders of another seed.
-            let mut best = (SampleShear::NONE, f64::INFINITY);
-            for &c in &candidates {
-                let shears = vec![c; analysis.len()];
-                let maps = render_variance(
-                    &scene,
-                    s.as_ref(),
-                    &shears,
-                    seed ^ SELECTION_STREAM,
-                    2,
-                    &|| {},
-                )?;
-                let v = PixelStatistics::of(&maps.variance.pixels).mean;
-                if v < best.1 {
-                    best = (c, v);
-                }
-            }
-            let mut means = Vec::new();
-            for &(name, policy) in &POLICIES {
-                let policy = match policy {
-                    ShearPolicy::Global(_) => ShearPolicy::Global(best.0),
-                    p => p,
-                };
-                let shears = pixel_shears(&scene, s.as_ref(), policy, &analysis, seed)?;
-                let maps = render_variance(&scene, s.as_ref(), &shears, seed, renders, &|| {})?;
-                let mse = mse_against(
-                    &maps.mean.pixels,
-                    Some(&maps.variance.pixels),
-                    renders,
-                    &reference.pixels,
-                );
-                let stats = PixelStatistics::of(&maps.variance.pixels);
-                let label = match policy {
-                    ShearPolicy::Global(c) => format!("{} {}", c.form(), c.amounts()[0]),
-                    ShearPolicy::None => "none".into(),
-                    _ => "per pixel".into(),
-                };
-                table += &format!(
-                    "| {n} | {name} | {label} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} |\n",
-                    stats.mean, stats.median, stats.p95
-                );
-                rows.push(vec![
-                    n.to_string(),
-                    name.into(),
-                    label,
-                    renders.to_string(),
-                    format!("{:e}", stats.mean),
-                    format!("{:e}", stats.median),
-                    format!("{:e}", stats.p95),
-                    format!("{mse:e}"),
-                ]);
-                means.push(stats.mean);
-                if requested == heatmap_spp && name != "best global" {
-                    maps.variance.write_variance_png(
-                        &format!(
-                            "{}, {sampler} {n} spp, {name}: per-pixel variance ({renders} renders)",
-                            scene.name()
-                        ),
-                        Some((-6.0, -2.0)),
-                        &out.join(format!("{prefix}-variance-{}.png", name.replace(' ', "-"))),
-                    )?;
-                }
-            }
-            gains += &format!(
-                "- {n} spp: per-pixel analytic {:.2}× below none, {:.2}× below the best global shear; \
-                 pilot {:.2}× below none.\n",
-                means[0] / means[2],
-                means[1] / means[2],
-                means[0] / means[3]
-            );
-        }
-        let name = format!("{prefix}.csv");
-        write_csv(
-            out,
-            &name,
-            &[
-                "spp",
-                "method",
-                "shear",
-                "renders",
-                "mean_variance",
-                "median_variance",
-                "p95_variance",
-                "mse_vs_reference",
-            ],
-            &rows,
-            &|what, err| ExperimentError::Invalid {
-                file: what.to_string(),
-                reason: err,
-            },
-        )?;
-        Ok(format!(
-            "- `{prefix}.csv`, `{prefix}-variance-{{none,per-pixel-analytic,per-pixel-pilot}}.png` \
-             (at {heatmap_spp} spp), `{prefix}-reference.pfm` (Sobol' {reference_n} spp, 2 renders): \
-             scene `{}` with {sampler}, per-pixel variance over {renders} renders, MSE against the \
-             reference.\n\n{table}\n{gains}",
-            scene.name()
-        ))
     }
 
     /// Draws one figure; returns its README entry.
@@ -822,7 +742,7 @@ impl FigureExperiment {
                     None => sampler.clone(),
                 };
                 let title = format!("{what}, N = {m}");
-                self.plane_pngs(out, prefix, &title, planes, *sets, *res, &|r| {
+                plane_pngs(out, prefix, &title, planes, (*sets, *res), &|r| {
                     drawn.sample(&mut set_rng(self.seed, r as u64))
                 })?;
                 Ok(format!(
@@ -854,7 +774,7 @@ impl FigureExperiment {
                     &|_, _| {},
                 )?;
                 let title = format!("designed 4D sets, N = {n}");
-                self.plane_pngs(out, prefix, &title, planes, *sets, *res, &|r| {
+                plane_pngs(out, prefix, &title, planes, (*sets, *res), &|r| {
                     Ok(design.points[r].clone())
                 })?;
                 let mut terms = String::from(
@@ -886,15 +806,50 @@ impl FigureExperiment {
                 renders,
                 heatmap_spp,
                 reference_spp,
-            } => self.scene_variance(
+            } => scene_variance(
+                self.seed,
                 out,
                 prefix,
                 scene,
                 sampler,
                 spp,
                 *renders,
-                *heatmap_spp,
+                (*heatmap_spp, *reference_spp),
+            ),
+            Figure::SceneSamplers {
+                file,
+                scenes,
+                samplers,
+                spp,
+                renders,
+                reference_spp,
+            } => scene_samplers(
+                self.seed,
+                out,
+                file,
+                scenes,
+                samplers,
+                *spp,
+                *renders,
                 *reference_spp,
+            ),
+            Figure::ScenePixels {
+                prefix,
+                scene,
+                sampler,
+                n,
+                pixels,
+                sets,
+                res,
+            } => scene_pixels(
+                self.seed,
+                out,
+                prefix,
+                scene,
+                sampler,
+                *n,
+                pixels,
+                (*sets, *res),
             ),
             Figure::ShearConvergence {
                 file,
@@ -973,16 +928,5 @@ impl FigureExperiment {
                 ))
             }
         }
-    }
-}
-
-/// A projection plane of a 4D set: its coordinates and frequency axes.
-fn plane(name: &str) -> Result<([usize; 2], [&'static str; 2]), String> {
-    match name {
-        "xy" => Ok(([0, 1], ["kx", "ky"])),
-        "uv" => Ok(([2, 3], ["ku", "kv"])),
-        "xu" => Ok(([0, 2], ["kx", "ku"])),
-        "yv" => Ok(([1, 3], ["ky", "kv"])),
-        other => Err(format!("plane `{other}`: one of xy, uv, xu, yv")),
     }
 }

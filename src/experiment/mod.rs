@@ -9,8 +9,10 @@
 //! Slurm job array). [`report`] writes the tables from the cells.
 
 mod figures;
+mod planes;
 mod report;
 mod run;
+mod scene_figures;
 mod spec;
 
 pub use figures::{Figure, FigureExperiment};

@@ -20,7 +20,7 @@ use description::{
 use geometry::{BvhKind, Geometry, Placement, dot};
 
 /// The built-in scenes: name, what it shows, its JSON.
-pub const BUILTIN_SCENES: [(&str, &str, &str); 3] = [
+pub const BUILTIN_SCENES: [(&str, &str, &str); 4] = [
     (
         "dof",
         "depth of field: a checkered box in focus between a defocused striped sphere and a \
@@ -36,6 +36,12 @@ pub const BUILTIN_SCENES: [(&str, &str, &str); 3] = [
         "shadows-disk",
         "the same under a disk light of the same area",
         include_str!("../../scenes/shadows-disk.json"),
+    ),
+    (
+        "shadows-disk-bounding-square",
+        "the same disk light with (u, v) uniform on its bounding square (the disk an indicator \
+         in (u, v): the seed's setting)",
+        include_str!("../../scenes/shadows-disk-bounding-square.json"),
     ),
 ];
 

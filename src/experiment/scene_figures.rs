@@ -1,0 +1,463 @@
+//! The figures drawn from the ray-traced scene (docs/scene.md): the seed's
+//! variance heat map original against sheared ([`scene_variance`]), its
+//! soft-shadow table of samplers on lights ([`scene_samplers`]) and single
+//! pixels' light fields with the shear their measurement chooses — the
+//! hairline and double-wedge cases ([`scene_pixels`]). Singh, Öztireli,
+//! Pilleboue & Jarosz, "Analysis of sample correlations for Monte Carlo
+//! rendering"; Soler et al. 2009 for the sheared light field of a pixel.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use super::planes::{plane, plane_pngs};
+use super::report::write_csv;
+use super::spec::ExperimentError;
+use crate::registry;
+use crate::report::plot::power_png;
+use crate::rng::set_rng;
+use crate::scene::Scene;
+use crate::scene::analysis::SampleShear;
+use crate::scene::pixel::PixelIntegrand;
+use crate::scene::pixel_shear::{Measured, PixelShearOptions, search_pixel_shear};
+use crate::scene::render::{
+    PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, reference_image,
+    render_variance,
+};
+
+/// Most samples per pixel a scene figure may ask for.
+pub(super) const MAX_SPP: usize = 1 << 16;
+/// Most renders per policy of a scene figure.
+pub(super) const MAX_RENDERS: usize = 4096;
+/// Stream offsets of the scene figures' references and of the choice of
+/// the best global shear (independent of the renders they score).
+const REFERENCE_STREAM: u64 = 0x7e_fe7e;
+const SELECTION_STREAM: u64 = 0x5e_1ec7;
+/// The references' sampler: Owen-scrambled Sobol' by Burley's hash
+/// (JCGT 9(4), 2020), unbiased like the nested scramble and three times
+/// faster to draw at 4096 points a pixel, where drawing the nested scramble
+/// took longer than tracing the rays.
+pub(super) const REFERENCE_SAMPLER: &str = "sobol:scramble=hash";
+/// Random points per cell of a pixel's light-field power
+/// ([`PixelIntegrand::plane_power`]).
+const LIGHT_FIELD_POINTS_PER_CELL: usize = 16;
+/// The planes of a pixel figure: the seed's XU and YV.
+const PIXEL_PLANES: [&str; 2] = ["xu", "yv"];
+
+/// The scene-variance figure's shear policies, in table order ("best
+/// global" takes the chosen shear).
+pub(super) const POLICIES: [(&str, ShearPolicy); 4] = [
+    ("none", ShearPolicy::None),
+    ("best global", ShearPolicy::Global(SampleShear::NONE)),
+    ("per-pixel analytic", ShearPolicy::Analytic),
+    ("per-pixel pilot", ShearPolicy::Pilot { pilots: 8 }),
+];
+
+/// Files of a pixel figure: `PREFIX.csv` and, per pixel,
+/// `PREFIX-X-Y-{f,before,after}-{xu,yv}.png`.
+pub(super) fn pixel_files(prefix: &str, pixels: &[[usize; 2]]) -> Vec<String> {
+    let mut files = vec![format!("{prefix}.csv")];
+    for [x, y] in pixels {
+        for what in ["f", "before", "after"] {
+            for p in PIXEL_PLANES {
+                files.push(format!("{prefix}-{x}-{y}-{what}-{p}.png"));
+            }
+        }
+    }
+    files
+}
+
+/// How a table fails to be written, in the figures' error.
+fn table_error(what: &str, err: String) -> ExperimentError {
+    ExperimentError::Invalid {
+        file: what.to_string(),
+        reason: err,
+    }
+}
+
+/// The depth-of-field scene's per-pixel variance under the four
+/// [`POLICIES`] at each spp (see [`super::Figure::SceneVariance`]);
+/// returns its README entry.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn scene_variance(
+    seed: u64,
+    out: &Path,
+    prefix: &str,
+    scene: &str,
+    sampler: &str,
+    spp: &[usize],
+    renders: usize,
+    (heatmap_spp, reference_spp): (usize, usize),
+) -> Result<String, Box<dyn std::error::Error>> {
+    let scene = Scene::load(scene)?;
+    let analysis = analyse(&scene);
+    let (sobol, reference_n) =
+        registry::build_nearest(REFERENCE_SAMPLER, reference_spp, Some(4), &[])?;
+    let reference = reference_image(&scene, sobol.as_ref(), seed ^ REFERENCE_STREAM)?;
+    reference.write_pfm(&out.join(format!("{prefix}-reference.pfm")))?;
+    let mut candidates = vec![SampleShear::NONE];
+    for k in [-8.0, -6.0, -4.0, -2.0, -1.0, 1.0, 2.0, 4.0, 6.0, 8.0] {
+        candidates.push(SampleShear::Warp(k));
+    }
+    for a in [-1.0, -0.5, 0.5, 1.0] {
+        candidates.push(SampleShear::Position([a, a]));
+    }
+    let mut rows: Vec<Vec<String>> = Vec::new();
+    let mut table = String::from(
+        "| spp | policy | shear | mean variance | median | 95th percentile | MSE vs reference |\n\
+         |---|---|---|---|---|---|---|\n",
+    );
+    let mut gains = String::new();
+    for &requested in spp {
+        let (s, n) = registry::build_nearest(sampler, requested, Some(4), &[])?;
+        // The best global transformation on 2 renders of another seed.
+        let mut best = (SampleShear::NONE, f64::INFINITY);
+        for &c in &candidates {
+            let shears = vec![c; analysis.len()];
+            let maps = render_variance(
+                &scene,
+                s.as_ref(),
+                &shears,
+                seed ^ SELECTION_STREAM,
+                2,
+                &|| {},
+            )?;
+            let v = PixelStatistics::of(&maps.variance.pixels).mean;
+            if v < best.1 {
+                best = (c, v);
+            }
+        }
+        let mut means = Vec::new();
+        for &(name, policy) in &POLICIES {
+            let policy = match policy {
+                ShearPolicy::Global(_) => ShearPolicy::Global(best.0),
+                p => p,
+            };
+            let shears = pixel_shears(&scene, s.as_ref(), policy, &analysis, seed)?;
+            let maps = render_variance(&scene, s.as_ref(), &shears, seed, renders, &|| {})?;
+            let mse = mse_against(
+                &maps.mean.pixels,
+                Some(&maps.variance.pixels),
+                renders,
+                &reference.pixels,
+            );
+            let stats = PixelStatistics::of(&maps.variance.pixels);
+            let label = match policy {
+                ShearPolicy::Global(c) => format!("{} {}", c.form(), c.amounts()[0]),
+                ShearPolicy::None => "none".into(),
+                _ => "per pixel".into(),
+            };
+            table += &format!(
+                "| {n} | {name} | {label} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} |\n",
+                stats.mean, stats.median, stats.p95
+            );
+            rows.push(vec![
+                n.to_string(),
+                name.into(),
+                label,
+                renders.to_string(),
+                format!("{:e}", stats.mean),
+                format!("{:e}", stats.median),
+                format!("{:e}", stats.p95),
+                format!("{mse:e}"),
+            ]);
+            means.push(stats.mean);
+            if requested == heatmap_spp && name != "best global" {
+                maps.variance.write_variance_png(
+                    &format!(
+                        "{}, {sampler} {n} spp, {name}: per-pixel variance ({renders} renders)",
+                        scene.name()
+                    ),
+                    Some((-6.0, -2.0)),
+                    &out.join(format!("{prefix}-variance-{}.png", name.replace(' ', "-"))),
+                )?;
+            }
+        }
+        gains += &format!(
+            "- {n} spp: per-pixel analytic {:.2}× below none, {:.2}× below the best global shear; \
+             pilot {:.2}× below none.\n",
+            means[0] / means[2],
+            means[1] / means[2],
+            means[0] / means[3]
+        );
+    }
+    write_csv(
+        out,
+        &format!("{prefix}.csv"),
+        &[
+            "spp",
+            "method",
+            "shear",
+            "renders",
+            "mean_variance",
+            "median_variance",
+            "p95_variance",
+            "mse_vs_reference",
+        ],
+        &rows,
+        &table_error,
+    )?;
+    Ok(format!(
+        "- `{prefix}.csv`, `{prefix}-variance-{{none,per-pixel-analytic,per-pixel-pilot}}.png` \
+         (at {heatmap_spp} spp), `{prefix}-reference.pfm` (hash-scrambled Sobol' {reference_n} spp, 2 renders): \
+         scene `{}` with {sampler}, per-pixel variance over {renders} renders, MSE against the \
+         reference.\n\n{table}\n{gains}",
+        scene.name()
+    ))
+}
+
+/// The seed's soft-shadow table: every sampler on every scene at one spp,
+/// without shear, the mean per-pixel variance over `renders` renders and
+/// the relative RMS error √(mean per-render MSE) / (mean reference value)
+/// against a [`REFERENCE_SAMPLER`] reference of each scene; returns its README entry.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn scene_samplers(
+    seed: u64,
+    out: &Path,
+    file: &str,
+    scenes: &[String],
+    samplers: &[String],
+    spp: usize,
+    renders: usize,
+    reference_spp: usize,
+) -> Result<String, Box<dyn std::error::Error>> {
+    let (sobol, reference_n) =
+        registry::build_nearest(REFERENCE_SAMPLER, reference_spp, Some(4), &[])?;
+    let mut rows: Vec<Vec<String>> = Vec::new();
+    // cells[sampler][scene]: "variance (relative RMS)".
+    let mut cells = vec![Vec::new(); samplers.len()];
+    let mut used = vec![String::new(); samplers.len()];
+    for name in scenes {
+        let scene = Scene::load(name)?;
+        let [w, h] = scene.camera().resolution();
+        let reference = reference_image(&scene, sobol.as_ref(), seed ^ REFERENCE_STREAM)?;
+        let level = PixelStatistics::of(&reference.pixels).mean;
+        for (i, sampler) in samplers.iter().enumerate() {
+            let (s, n) = registry::build_nearest(sampler, spp, Some(4), &[])?;
+            let none = vec![SampleShear::NONE; w * h];
+            let maps = render_variance(&scene, s.as_ref(), &none, seed, renders, &|| {})?;
+            let mse = mse_against(
+                &maps.mean.pixels,
+                Some(&maps.variance.pixels),
+                renders,
+                &reference.pixels,
+            );
+            let variance = PixelStatistics::of(&maps.variance.pixels).mean;
+            let relative = mse.sqrt() / level;
+            cells[i].push(format!("{variance:.3e} ({:.2}%)", 100.0 * relative));
+            used[i] = format!("{sampler} ({n} spp)");
+            rows.push(vec![
+                name.clone(),
+                sampler.clone(),
+                n.to_string(),
+                renders.to_string(),
+                format!("{variance:e}"),
+                format!("{mse:e}"),
+                format!("{relative:e}"),
+            ]);
+        }
+    }
+    write_csv(
+        out,
+        file,
+        &[
+            "scene",
+            "sampler",
+            "spp",
+            "renders",
+            "mean_variance",
+            "mse_vs_reference",
+            "relative_rms_error",
+        ],
+        &rows,
+        &table_error,
+    )?;
+    let mut table = format!(
+        "| sampler | {} |\n|---|{}\n",
+        scenes
+            .iter()
+            .map(|s| format!("`{s}`"))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        "---|".repeat(scenes.len())
+    );
+    for (name, row) in used.iter().zip(&cells) {
+        table += &format!("| {name} | {} |\n", row.join(" | "));
+    }
+    Ok(format!(
+        "- `{file}`: mean per-pixel variance over {renders} renders (relative RMS error against \
+         a hash-scrambled Sobol' {reference_n}-spp reference of 2 renders, in parentheses), no shear.\n\n{table}"
+    ))
+}
+
+/// Single pixels of a scene as integrands ([`PixelIntegrand`]): each
+/// pixel's light-field power on the XU and YV planes, the transformation
+/// its measured search chooses ([`search_pixel_shear`]: the render's
+/// unshifted estimator, all candidates on the same realizations, until the
+/// chosen one's relative standard error is 2%), and the spectra of `sets`
+/// realizations before and after it; returns the README entry.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn scene_pixels(
+    seed: u64,
+    out: &Path,
+    prefix: &str,
+    scene: &str,
+    sampler: &str,
+    n: usize,
+    pixels: &[[usize; 2]],
+    (sets, res): (usize, usize),
+) -> Result<String, Box<dyn std::error::Error>> {
+    let scene = Arc::new(Scene::load(scene)?);
+    let (s, n) = registry::build_nearest(sampler, n, Some(4), &[])?;
+    let planes: Vec<String> = PIXEL_PLANES.iter().map(|p| p.to_string()).collect();
+    let mut rows: Vec<Vec<String>> = Vec::new();
+    let mut table = String::from(
+        "| pixel | kind | κ of the probed depths | no shear | chosen | variance | lower by | \
+         ±0.01 on the slope | realizations |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for &[px, py] in pixels {
+        let f = PixelIntegrand::new(Arc::clone(&scene), px, py);
+        let found = search_pixel_shear(
+            &f,
+            s.as_ref(),
+            PixelShearOptions {
+                seed,
+                ..PixelShearOptions::default()
+            },
+        )?;
+        let (none, best) = (found.unsheared(), found.best());
+        let here = format!("{prefix}-{px}-{py}");
+        for p in &planes {
+            let (dims, axes) = plane(p)?;
+            let power = f.plane_power(dims, res, LIGHT_FIELD_POINTS_PER_CELL, seed)?;
+            power_png(
+                &power,
+                &format!(
+                    "pixel ({px}, {py}) of {}: light field, {p} plane",
+                    scene.name()
+                ),
+                axes,
+                "log10 |F_f(k)|^2",
+                &out.join(format!("{here}-f-{p}.png")),
+            )?;
+        }
+        let draw = |r: usize| s.sample(&mut set_rng(seed, r as u64));
+        let title = format!("{sampler} N = {n}");
+        plane_pngs(
+            out,
+            &format!("{here}-before"),
+            &format!("{title}, no shear"),
+            &planes,
+            (sets, res),
+            &draw,
+        )?;
+        plane_pngs(
+            out,
+            &format!("{here}-after"),
+            &format!(
+                "{title}, {} {:.3}",
+                best.shear.form(),
+                best.shear.amounts()[0]
+            ),
+            &planes,
+            (sets, res),
+            &|r| Ok(best.shear.apply(draw(r)?)),
+        )?;
+        let a = &found.analysis;
+        let kappas: Vec<String> = a.kappas.iter().map(|k| format!("{k:.3}")).collect();
+        let kind = if found.hairline {
+            format!("{} (hairline)", a.kind.name())
+        } else if found.double_wedge {
+            format!("{} (double wedge)", a.kind.name())
+        } else {
+            a.kind.name().to_string()
+        };
+        // A constant pixel (variance 0) has no relative error or ratio.
+        let cell = |m: &Measured| match m.estimate.variance {
+            0.0 => "0 (constant)".to_string(),
+            v => format!("{v:.3e} ± {:.0}%", 100.0 * m.estimate.stderr / v),
+        };
+        let lower = match best.estimate.variance {
+            0.0 => "—".to_string(),
+            v => format!("{:.2}×", none.estimate.variance / v),
+        };
+        let sensitivity = found.sensitivity.as_ref().map_or("—".to_string(), |s| {
+            format!(
+                "{:.3}× / {:.3}×",
+                s[0].estimate.variance / best.estimate.variance,
+                s[1].estimate.variance / best.estimate.variance
+            )
+        });
+        table += &format!(
+            "| ({px}, {py}) | {kind} | {} | {} | {} {:.3} | {} | {lower} | {sensitivity} | {} |\n",
+            kappas.join(", "),
+            cell(none),
+            best.shear.form(),
+            best.shear.amounts()[0],
+            cell(best),
+            best.estimate.realizations
+        );
+        let [a0, a1] = best.shear.amounts();
+        let variance_at = |i: usize| {
+            found
+                .sensitivity
+                .as_ref()
+                .map_or(String::new(), |s| format!("{:e}", s[i].estimate.variance))
+        };
+        rows.push(vec![
+            px.to_string(),
+            py.to_string(),
+            a.kind.name().into(),
+            format!("{:e}", a.depth),
+            format!("{:e}", a.kappa),
+            kappas.join(";"),
+            best.shear.form().into(),
+            format!("{a0:e}"),
+            format!("{a1:e}"),
+            format!("{:e}", none.estimate.variance),
+            format!("{:e}", none.estimate.stderr),
+            format!("{:e}", best.estimate.variance),
+            format!("{:e}", best.estimate.stderr),
+            best.estimate.realizations.to_string(),
+            variance_at(0),
+            variance_at(1),
+            found.double_wedge.to_string(),
+            found.hairline.to_string(),
+        ]);
+    }
+    write_csv(
+        out,
+        &format!("{prefix}.csv"),
+        &[
+            "px",
+            "py",
+            "kind",
+            "depth",
+            "kappa",
+            "kappas",
+            "chosen_form",
+            "chosen_a",
+            "chosen_b",
+            "variance_unsheared",
+            "stderr_unsheared",
+            "variance_chosen",
+            "stderr_chosen",
+            "realizations",
+            "variance_slope_minus_0.01",
+            "variance_slope_plus_0.01",
+            "double_wedge",
+            "hairline",
+        ],
+        &rows,
+        &table_error,
+    )?;
+    Ok(format!(
+        "- `{prefix}.csv`, `{prefix}-X-Y-{{f,before,after}}-{{xu,yv}}.png`: pixels of `{}` as \
+         integrands with {sampler} at N = {n}: the light field's power (`f`, a {res}² grid), the \
+         transformation the measured search chooses among no shear and, per probed depth, the \
+         position shear −κ and the footprint warp κ (the render's unshifted estimator, common \
+         realizations, 2% relative standard error on the choice), and the spectra of {sets} sets \
+         before and after it. A pixel is a double wedge when its probes meet two depths, a \
+         hairline when moving the warp's slope by ±0.01 raises the variance by half.\n\n{table}",
+        scene.name()
+    ))
+}
