@@ -40,8 +40,7 @@ fn agree_on(set: &PointSet, spec: &str, half: usize, realizations: usize) -> Agr
     common::direct::check_fourier(
         &label,
         f.as_ref(),
-        std::slice::from_ref(set),
-        half,
+        &common::direct::SetPowers::of(std::slice::from_ref(set), half),
         1e-12,
         &four,
         Some(&s),
@@ -194,10 +193,11 @@ fn defocus_has_no_spatial_form_and_says_so() {
     )
     .unwrap();
     let one = std::slice::from_ref(&set);
-    common::direct::check_fourier("defocus", f.as_ref(), one, 7, 1e-9, &four, None);
+    let powers = common::direct::SetPowers::of(one, 7);
+    common::direct::check_fourier("defocus", f.as_ref(), &powers, 1e-9, &four, None);
     // The exact variance of a fixed set lies between its in-box part and
     // that plus the whole Parseval tail T (every |S|²/N² ≤ 1 beyond the box).
-    let d = common::direct::split(f.as_ref(), one, 7);
+    let d = common::direct::split(f.as_ref(), &powers);
     let (low, high) = (
         d.in_box - Z * e.stderr,
         d.in_box + d.tail_mass + Z * e.stderr,

@@ -84,8 +84,7 @@ fn spatial_fourier_and_empirical_forms_agree_with_a_random_count() {
     common::direct::check_fourier(
         "isotropic jitter",
         f.as_ref(),
-        &sets,
-        127,
+        &common::direct::SetPowers::of(&sets, 127),
         1e-10,
         &four,
         Some(&s),

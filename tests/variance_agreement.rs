@@ -42,6 +42,8 @@ const Z: f64 = 4.5;
 const NUFFT_TOL: f64 = 1e-10;
 /// The Fourier form's box |k|∞ ≤ HALF.
 const HALF: usize = 63;
+/// Realizations both forms and the direct DFT share.
+const SETS: usize = 12;
 
 /// Realizations for the empirical form (2000 at N = 1024, 4000 below) and
 /// the spatial mean (32 and 200): drawn once per sampler, lent to every
@@ -50,19 +52,25 @@ fn realizations(n: usize) -> (usize, usize) {
     if n > 256 { (2000, 32) } else { (4000, 200) }
 }
 
-/// `pool[..sets]` go to both forms and the direct check.
-fn check(name: &str, f: &dyn Integrand, pool: &[PointSet], sets: usize, seed: u64) {
+/// `pool[..sets]` go to both forms and the direct check, whose DFT
+/// `powers` of those sets every integrand shares.
+fn check(
+    name: &str,
+    f: &dyn Integrand,
+    pool: &[PointSet],
+    (sets, powers): (usize, &common::direct::SetPowers),
+    seed: u64,
+) {
     let n = pool[0].len();
     let (shifted, total) = realizations(n);
     let realization = |r: usize| -> Result<_, VarianceError> { Ok(pool[r].clone()) };
-    let drawn = &pool[..sets];
     let lend = realization;
     let s = spatial(f, sets, lend).unwrap();
     let four = fourier(f, HALF, NUFFT_TOL, sets, lend).unwrap();
     // Both forms on the same sets against a direct DFT written in the test
     // and the rigorous limits of the tail (tests/common/direct.rs).
     let label = format!("{name} N={n} {}", f.spec());
-    common::direct::check_fourier(&label, f, drawn, HALF, NUFFT_TOL, &four, Some(&s));
+    common::direct::check_fourier(&label, f, powers, NUFFT_TOL, &four, Some(&s));
     // The error bar users see: the Fourier form's truncation bound must
     // cover its distance from the exact value (a test of the bound, whose
     // tolerance is therefore the bound itself, plus NUFFT and rounding).
@@ -123,9 +131,10 @@ fn run_for(n: usize) {
             .into_par_iter()
             .map(|r| sampler.sample(&mut set_rng(seed, r as u64)).unwrap())
             .collect();
+        let powers = common::direct::SetPowers::of(&pool[..SETS], HALF);
         for spec in INTEGRANDS {
             let f = integrands::parse(spec).unwrap();
-            check(name, f.as_ref(), &pool, 12, seed);
+            check(name, f.as_ref(), &pool, (SETS, &powers), seed);
         }
     }
 }

@@ -95,9 +95,35 @@ fn structure(set: &PointSet, half: i64) -> Vec<Complex64> {
     total
 }
 
-/// The direct split of `sets` against `f` on the box |k|∞ ≤ half.
-pub fn split(f: &dyn Integrand, sets: &[PointSet], half: i64) -> DirectSplit {
-    let dim = f.dim();
+/// |S(k)|² of fixed sets on the box |k|∞ ≤ half by direct DFT, with each
+/// set's intensity and count: what the split needs of the sets, computed
+/// once for every integrand they are checked against.
+pub struct SetPowers {
+    half: i64,
+    /// Per set: |S(k)|² in box order, λ and N.
+    sets: Vec<(Vec<f64>, f64, usize)>,
+}
+
+impl SetPowers {
+    /// The powers of `sets` on the box |k|∞ ≤ half.
+    pub fn of(sets: &[PointSet], half: usize) -> SetPowers {
+        let half = half as i64;
+        SetPowers {
+            half,
+            sets: sets
+                .iter()
+                .map(|set| {
+                    let power = structure(set, half).iter().map(|v| v.norm_sqr()).collect();
+                    (power, set.intensity(), set.len())
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The direct split of the sets behind `powers` against `f`.
+pub fn split(f: &dyn Integrand, powers: &SetPowers) -> DirectSplit {
+    let (dim, half) = (f.dim(), powers.half);
     let len = ((2 * half + 1) as usize).pow(dim as u32);
     let pf: Vec<f64> = (0..len)
         .map(|idx| {
@@ -112,45 +138,38 @@ pub fn split(f: &dyn Integrand, sets: &[PointSet], half: i64) -> DirectSplit {
     let box_mass: f64 = pf.iter().sum();
     let integral = f.fourier(&vec![0; dim]).re;
     let (mut in_box, mut tail_factor, mut count_term) = (0.0, 0.0f64, 0.0);
-    for set in sets {
-        let lam = set.intensity();
-        let s = structure(set, half);
-        in_box += s
-            .iter()
-            .zip(&pf)
-            .map(|(v, w)| v.norm_sqr() * w)
-            .sum::<f64>()
-            / (lam * lam);
-        let ratio = set.len() as f64 / lam;
+    for (power, lam, count) in &powers.sets {
+        assert_eq!(power.len(), len, "powers of {}D sets", f.dim());
+        in_box += power.iter().zip(&pf).map(|(v, w)| v * w).sum::<f64>() / (lam * lam);
+        let ratio = *count as f64 / lam;
         tail_factor = tail_factor.max(ratio * ratio);
         count_term += (ratio - 1.0) * (ratio - 1.0) * integral * integral;
     }
-    let r = sets.len() as f64;
+    let r = powers.sets.len() as f64;
     DirectSplit {
         in_box: in_box / r,
         tail_mass: (f.variance() - box_mass).max(0.0),
         box_mass,
         tail_factor,
         count_term: count_term / r,
-        intensity: sets[0].intensity(),
+        intensity: powers.sets[0].1,
     }
 }
 
-/// Checks a Fourier estimate of `sets` (box `half`, NUFFT `tolerance`)
-/// piece by piece against the direct split, and the exact spatial variance
+/// Checks a Fourier estimate of the sets behind `powers` (on their box,
+/// NUFFT `tolerance`) piece by piece against the direct split, and the exact spatial variance
 /// (with its rounding bound), when there is one, against the split's
 /// rigorous limits. The tolerances are the NUFFT's accuracy and
 /// floating-point rounding, none from the code's own error estimates.
 pub fn check_fourier(
     label: &str,
     f: &dyn Integrand,
-    sets: &[PointSet],
-    half: usize,
+    powers: &SetPowers,
     tolerance: f64,
     four: &varspec::variance::FourierEstimate,
     spatial: Option<&varspec::variance::SpatialEstimate>,
 ) {
-    let d = split(f, sets, half as i64);
+    let d = split(f, powers);
     // c_f(0) sets the scale; the box's own mass too where the closed forms
     // of c_f(0) and P_f disagree in the last bits (a degenerate f ≈ 0).
     let scale = f.variance().max(d.box_mass);
