@@ -52,15 +52,16 @@ fn realizations(n: usize) -> (usize, usize) {
     if n > 256 { (2000, 32) } else { (4000, 200) }
 }
 
-/// `pool[..sets]` go to both forms and the direct check, whose DFT
+/// `pool[..SETS]` go to both forms and the direct check, whose DFT
 /// `powers` of those sets every integrand shares.
 fn check(
     name: &str,
     f: &dyn Integrand,
     pool: &[PointSet],
-    (sets, powers): (usize, &common::direct::SetPowers),
+    powers: &common::direct::SetPowers,
     seed: u64,
 ) {
+    let sets = SETS;
     let n = pool[0].len();
     let (shifted, total) = realizations(n);
     let realization = |r: usize| -> Result<_, VarianceError> { Ok(pool[r].clone()) };
@@ -134,7 +135,7 @@ fn run_for(n: usize) {
         let powers = common::direct::SetPowers::of(&pool[..SETS], HALF);
         for spec in INTEGRANDS {
             let f = integrands::parse(spec).unwrap();
-            check(name, f.as_ref(), &pool, (SETS, &powers), seed);
+            check(name, f.as_ref(), &pool, &powers, seed);
         }
     }
 }

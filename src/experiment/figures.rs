@@ -1,6 +1,7 @@
 //! Figure experiments (`"kind": "figures"`): a list of the course's figures
 //! — expected spectra, their radial averages, the variance formula's
-//! ingredients, convergence before and after a shear — each drawn to a PNG
+//! ingredients, convergence before and after a shear, and the rendered
+//! scene's (src/experiment/scene_figures.rs) — each drawn to a PNG
 //! by the same library calls the commands use, with the numbers each
 //! figure shows in a `README.md` beside them (Singh, Öztireli, Pilleboue &
 //! Jarosz, "Analysis of sample correlations for Monte Carlo rendering";
@@ -275,7 +276,7 @@ impl Figure {
 impl FigureExperiment {
     /// Parses and validates the text of file `file`: every sampler and
     /// integrand exists in its dimension, sizes are bounded, file names are
-    /// plain names written once (`.png`, but for the scene figure's table
+    /// plain names written once (`.png`, but for the scene figures' tables
     /// and reference).
     ///
     /// # Errors
@@ -484,6 +485,15 @@ impl FigureExperiment {
                     }
                     if scenes.is_empty() || samplers.is_empty() {
                         return Err(at("scenes and samplers must be non-empty".into()));
+                    }
+                    for (what, list) in [("scene", scenes), ("sampler", samplers)] {
+                        if let Some((j, name)) = list
+                            .iter()
+                            .enumerate()
+                            .find(|(j, s)| list[..*j].contains(s))
+                        {
+                            return Err(at(format!("{what} `{name}` is given twice (at {j})")));
+                        }
                     }
                     for scene in scenes {
                         Scene::load(scene).map_err(|err| at(err.to_string()))?;

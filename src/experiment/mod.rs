@@ -9,6 +9,7 @@
 //! Slurm job array). [`report`] writes the tables from the cells.
 
 mod figures;
+mod file;
 mod planes;
 mod report;
 mod run;
@@ -17,6 +18,7 @@ mod spec;
 
 pub use figures::{Figure, FigureExperiment};
 
+pub use file::ExperimentFile;
 pub use report::{remove_other_runs, remove_variance_runs, write_results};
 pub use run::{Cell, RadialCell, Shard, ShardFile, merge_shards, run_items};
-pub use spec::{Experiment, ExperimentError, ExperimentFile, RadialComparison};
+pub use spec::{Experiment, ExperimentError, RadialComparison};

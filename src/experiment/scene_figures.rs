@@ -12,6 +12,7 @@ use std::sync::Arc;
 use super::planes::{plane, plane_pngs};
 use super::report::write_csv;
 use super::spec::ExperimentError;
+use crate::optimize::shear::SENSITIVITY_STEP;
 use crate::registry;
 use crate::report::plot::power_png;
 use crate::rng::set_rng;
@@ -231,6 +232,13 @@ pub(super) fn scene_samplers(
         let [w, h] = scene.camera().resolution();
         let reference = reference_image(&scene, sobol.as_ref(), seed ^ REFERENCE_STREAM)?;
         let level = PixelStatistics::of(&reference.pixels).mean;
+        if level <= 0.0 {
+            return Err(format!(
+                "scene `{name}`: the reference image is black (mean {level:e}): a relative error \
+                 needs a lit scene"
+            )
+            .into());
+        }
         for (i, sampler) in samplers.iter().enumerate() {
             let (s, n) = registry::build_nearest(sampler, spp, Some(4), &[])?;
             let none = vec![SampleShear::NONE; w * h];
@@ -310,9 +318,10 @@ pub(super) fn scene_pixels(
     let (s, n) = registry::build_nearest(sampler, n, Some(4), &[])?;
     let planes: Vec<String> = PIXEL_PLANES.iter().map(|p| p.to_string()).collect();
     let mut rows: Vec<Vec<String>> = Vec::new();
-    let mut table = String::from(
+    let mut table = format!(
         "| pixel | kind | κ of the probed depths | no shear | chosen | variance | lower by | \
-         ±0.01 on the slope | realizations |\n|---|---|---|---|---|---|---|---|---|\n",
+         variance with the slope −{SENSITIVITY_STEP} / +{SENSITIVITY_STEP} | realizations |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
     );
     for &[px, py] in pixels {
         let f = PixelIntegrand::new(Arc::clone(&scene), px, py);
@@ -363,7 +372,8 @@ pub(super) fn scene_pixels(
             &|r| Ok(best.shear.apply(draw(r)?)),
         )?;
         let a = &found.analysis;
-        let kappas: Vec<String> = a.kappas.iter().map(|k| format!("{k:.3}")).collect();
+        let kappas: Vec<String> = a.kappas.iter().map(|k| format!("{k:e}")).collect();
+        let kappas_shown: Vec<String> = a.kappas.iter().map(|k| format!("{k:.3}")).collect();
         let kind = if found.hairline {
             format!("{} (hairline)", a.kind.name())
         } else if found.double_wedge {
@@ -389,7 +399,7 @@ pub(super) fn scene_pixels(
         });
         table += &format!(
             "| ({px}, {py}) | {kind} | {} | {} | {} {:.3} | {} | {lower} | {sensitivity} | {} |\n",
-            kappas.join(", "),
+            kappas_shown.join(", "),
             cell(none),
             best.shear.form(),
             best.shear.amounts()[0],
@@ -424,6 +434,10 @@ pub(super) fn scene_pixels(
             found.hairline.to_string(),
         ]);
     }
+    let (minus, plus) = (
+        format!("variance_slope_minus_{SENSITIVITY_STEP}"),
+        format!("variance_slope_plus_{SENSITIVITY_STEP}"),
+    );
     write_csv(
         out,
         &format!("{prefix}.csv"),
@@ -442,8 +456,8 @@ pub(super) fn scene_pixels(
             "variance_chosen",
             "stderr_chosen",
             "realizations",
-            "variance_slope_minus_0.01",
-            "variance_slope_plus_0.01",
+            &minus,
+            &plus,
             "double_wedge",
             "hairline",
         ],
@@ -457,7 +471,8 @@ pub(super) fn scene_pixels(
          position shear −κ and the footprint warp κ (the render's unshifted estimator, common \
          realizations, 2% relative standard error on the choice), and the spectra of {sets} sets \
          before and after it. A pixel is a double wedge when its probes meet two depths, a \
-         hairline when moving the warp's slope by ±0.01 raises the variance by half.\n\n{table}",
+         hairline when moving the warp's slope by ±{SENSITIVITY_STEP} raises the variance by \
+         half.\n\n{table}",
         scene.name()
     ))
 }

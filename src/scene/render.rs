@@ -219,7 +219,7 @@ pub struct VarianceMaps {
 }
 
 /// A reference image: the mean of renders 0 and 1 of `seed` with `sampler`
-/// and no shear (experiments use Owen-scrambled Sobol' at 4096 spp).
+/// and no shear (the scene figures use Sobol' with Burley's hash scramble).
 ///
 /// # Errors
 /// [`RenderError`].
