@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::planes::{TOLERANCE, plane, plane_pngs};
+use super::planes::{box_power, plane, plane_pngs};
 use super::scene_figures::{
     MAX_RENDERS, MAX_SPP, POLICIES, REFERENCE_SAMPLER, pixel_files, scene_pixels, scene_samplers,
     scene_variance,
@@ -28,8 +28,8 @@ use crate::report::plot::{LinePlot, Series, line_plot_png, power_png, spectrum_p
 use crate::rng::set_rng;
 use crate::samplers::Sampler;
 use crate::scene::Scene;
+use crate::spectrum::Spectrum;
 use crate::spectrum::radial::radial_profile;
-use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power};
 use crate::variance::fourier::integrand_power;
 use crate::variance::{VarianceError, empirical_shifting, fit_slope};
 
@@ -612,17 +612,9 @@ impl FigureExperiment {
         res: usize,
     ) -> Result<(Spectrum, usize), Box<dyn std::error::Error>> {
         let (sampler, n) = registry::build_nearest(name, n, Some(2), &[])?;
-        let spectrum = expected_power(
-            FrequencyBox::from_resolution(2, res),
-            Method::Fast {
-                tolerance: TOLERANCE,
-            },
-            sets,
-            |r| -> Result<_, VarianceError> {
-                Ok(sampler.sample(&mut set_rng(self.seed, r as u64))?)
-            },
-            &|| {},
-        )?;
+        let spectrum = box_power(sets, res, |r| {
+            Ok(sampler.sample(&mut set_rng(self.seed, r as u64))?)
+        })?;
         Ok((spectrum, n))
     }
 

@@ -7,11 +7,11 @@ use std::path::Path;
 use crate::points::PointSet;
 use crate::report::plot::power_png;
 use crate::samplers::SamplerError;
-use crate::spectrum::{FrequencyBox, Method, expected_power};
+use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power};
 use crate::variance::VarianceError;
 
 /// The NUFFT tolerance of the figures' spectra.
-pub(super) const TOLERANCE: f64 = 1e-9;
+const TOLERANCE: f64 = 1e-9;
 
 /// A projection plane of a 4D set: its coordinates and frequency axes.
 pub(super) fn plane(name: &str) -> Result<([usize; 2], [&'static str; 2]), String> {
@@ -22,6 +22,24 @@ pub(super) fn plane(name: &str) -> Result<([usize; 2], [&'static str; 2]), Strin
         "yv" => Ok(([1, 3], ["ky", "kv"])),
         other => Err(format!("plane `{other}`: one of xy, uv, xu, yv")),
     }
+}
+
+/// E[N·P_S] of the 2D sets `realization(r)`, r < `sets`, on a res² box by
+/// the NUFFT at [`TOLERANCE`]: every spectrum the figures draw.
+pub(super) fn box_power(
+    sets: usize,
+    res: usize,
+    realization: impl Fn(usize) -> Result<PointSet, VarianceError> + Sync,
+) -> Result<Spectrum, VarianceError> {
+    expected_power(
+        FrequencyBox::from_resolution(2, res),
+        Method::Fast {
+            tolerance: TOLERANCE,
+        },
+        sets,
+        realization,
+        &|| {},
+    )
 }
 
 /// E[N·P_S] of the projections `planes` of the 4D sets `realization(r)`,
@@ -36,19 +54,11 @@ pub(super) fn plane_pngs(
 ) -> Result<(), Box<dyn std::error::Error>> {
     for p in planes {
         let (dims, axes) = plane(p)?;
-        let spectrum = expected_power(
-            FrequencyBox::from_resolution(2, res),
-            Method::Fast {
-                tolerance: TOLERANCE,
-            },
-            sets,
-            |r| -> Result<_, VarianceError> {
-                Ok(realization(r)?
-                    .projected(&dims)
-                    .expect("a plane of a 4D set (checked with the experiment)"))
-            },
-            &|| {},
-        )?;
+        let spectrum = box_power(sets, res, |r| {
+            Ok(realization(r)?
+                .projected(&dims)
+                .expect("a plane of a 4D set (checked with the experiment)"))
+        })?;
         power_png(
             &spectrum,
             &format!("{title}: {p} projection ({sets} sets)"),
