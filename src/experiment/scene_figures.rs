@@ -21,8 +21,7 @@ use crate::scene::analysis::SampleShear;
 use crate::scene::pixel::PixelIntegrand;
 use crate::scene::pixel_shear::{Measured, PixelShearOptions, search_pixel_shear};
 use crate::scene::render::{
-    PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, reference_image,
-    render_variance,
+    PixelStatistics, ShearPolicy, analyse, pixel_shears, reference_image, render_variance,
 };
 
 /// Most samples per pixel a scene figure may ask for.
@@ -135,12 +134,7 @@ pub(super) fn scene_variance(
             };
             let shears = pixel_shears(&scene, s.as_ref(), policy, &analysis, seed)?;
             let maps = render_variance(&scene, s.as_ref(), &shears, seed, renders, &|| {})?;
-            let mse = mse_against(
-                &maps.mean.pixels,
-                Some(&maps.variance.pixels),
-                renders,
-                &reference.pixels,
-            );
+            let mse = maps.mse_against(&reference);
             let stats = PixelStatistics::of(&maps.variance.pixels);
             let label = match policy {
                 ShearPolicy::Global(c) => format!("{} {}", c.form(), c.amounts()[0]),
@@ -239,16 +233,11 @@ pub(super) fn scene_samplers(
             )
             .into());
         }
+        let none = vec![SampleShear::NONE; w * h];
         for (i, sampler) in samplers.iter().enumerate() {
             let (s, n) = registry::build_nearest(sampler, spp, Some(4), &[])?;
-            let none = vec![SampleShear::NONE; w * h];
             let maps = render_variance(&scene, s.as_ref(), &none, seed, renders, &|| {})?;
-            let mse = mse_against(
-                &maps.mean.pixels,
-                Some(&maps.variance.pixels),
-                renders,
-                &reference.pixels,
-            );
+            let mse = maps.mse_against(&reference);
             let variance = PixelStatistics::of(&maps.variance.pixels).mean;
             let relative = mse.sqrt() / level;
             cells[i].push(format!("{variance:.3e} ({:.2}%)", 100.0 * relative));

@@ -218,6 +218,19 @@ pub struct VarianceMaps {
     pub renders: usize,
 }
 
+impl VarianceMaps {
+    /// [`mse_against`] `reference` of these renders: the mean over pixels
+    /// of the per-render squared error.
+    pub fn mse_against(&self, reference: &GreyImage) -> f64 {
+        mse_against(
+            &self.mean.pixels,
+            Some(&self.variance.pixels),
+            self.renders,
+            &reference.pixels,
+        )
+    }
+}
+
 /// A reference image: the mean of renders 0 and 1 of `seed` with `sampler`
 /// and no shear (the scene figures use Sobol' with Burley's hash scramble).
 ///
