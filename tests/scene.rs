@@ -548,3 +548,68 @@ fn a_pixel_light_field_plane_matches_its_closed_form_marginal() {
         );
     }
 }
+
+#[test]
+fn the_pilot_measures_only_occlusion_edges_and_pinhole_pixels_are_not_warped() {
+    use varspec::scene::analysis::SampleShear;
+    use varspec::scene::render::{ShearPolicy, analyse, pixel_shears};
+    // A defocused occluder (depth 2, focus 3) over a striped plane at 6:
+    // its edge crosses column 4, the other columns see one depth.
+    let json = r#"{
+  "camera": {"resolution": [8, 8], "fov_degrees": 30, "position": [0, 0, 0],
+             "look_at": [0, 0, -1], "focal_distance": 3, "aperture": 0.3},
+  "integrand": "lens",
+  "ambient": 1.0,
+  "objects": [
+    {"shape": "quad", "scale": [200, 200, 1], "translate": [0, 0, -6],
+     "material": {"texture": "stripes", "period": 0.7, "low": 0.1, "high": 0.9}},
+    {"shape": "quad", "scale": [10, 10, 1], "translate": [-9.95, 0, -2],
+     "material": {"texture": "constant", "albedo": 0.5}}
+  ]
+}"#;
+    let scene = Scene::from_text(json, "occluder").unwrap();
+    let sampler = registry::build("umj", 16, Some(4), &[]).unwrap();
+    let analysis = analyse(&scene);
+    let analytic = pixel_shears(
+        &scene,
+        sampler.as_ref(),
+        ShearPolicy::Analytic,
+        &analysis,
+        5,
+    )
+    .unwrap();
+    let pilot = pixel_shears(
+        &scene,
+        sampler.as_ref(),
+        ShearPolicy::Pilot { pilots: 4 },
+        &analysis,
+        5,
+    )
+    .unwrap();
+    let edges = analysis
+        .iter()
+        .filter(|a| a.kind == PixelKind::Edge)
+        .count();
+    assert!(
+        (1..analysis.len() / 2).contains(&edges),
+        "{edges} edge pixels"
+    );
+    for ((a, analytic), pilot) in analysis.iter().zip(&analytic).zip(&pilot) {
+        assert_eq!(*analytic, SampleShear::Warp(a.kappa), "{a:?}");
+        if a.kind == PixelKind::Edge {
+            // One of the candidates: none, or a shear of a probed depth.
+            let probed = a.kappas.iter().any(|&k| {
+                *pilot == SampleShear::Warp(k) || *pilot == SampleShear::Position([-k, -k])
+            });
+            assert!(*pilot == SampleShear::NONE || probed, "{a:?}: {pilot:?}");
+        } else {
+            assert_eq!(pilot, analytic, "{a:?}");
+        }
+    }
+    // A pinhole looks at one point of the lens: κ = 0 and no shear (a warp
+    // of slope 0 would exchange the pixel and lens coordinates).
+    let shadows = Scene::load("shadows-square").unwrap();
+    let a = analyse_pixel(&shadows, 100, 100);
+    assert_eq!(a.kappa, 0.0);
+    assert_eq!(a.shear(), SampleShear::NONE);
+}

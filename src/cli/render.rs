@@ -13,7 +13,8 @@ use varspec::report::plot::{HeatMap, heatmap_png};
 use varspec::scene::analysis::{PixelKind, SampleShear};
 use varspec::scene::image::GreyImage;
 use varspec::scene::render::{
-    PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, render, render_variance,
+    DEFAULT_PILOTS, PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, render,
+    render_variance,
 };
 use varspec::scene::{BUILTIN_SCENES, Scene};
 
@@ -29,15 +30,16 @@ pub struct Args {
     /// as in every other command.
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'n', long, visible_alias = "n", default_value_t = 16)]
     spp: usize,
-    /// Shear of each pixel's set: none; analytic (the shear following the
-    /// centre depth's light field); pilot (the best of none and every
-    /// probed depth's shears by --pilots pilot estimates); A (x′ = x + A·u,
+    /// Shear of each pixel's set: none; analytic (the warp following the
+    /// centre depth's light field); pilot (analytic on single-depth pixels; on occlusion edges the best
+    /// of none and every probed depth's shears by --pilots pilot
+    /// estimates); A (x′ = x + A·u,
     /// y′ = y + A·v everywhere); warp:K (the footprint warp of slope K
     /// everywhere).
     #[arg(long, default_value = "none", allow_hyphen_values = true)]
     shear: String,
     /// Pilot estimates per candidate shear (--shear pilot).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 8)]
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = DEFAULT_PILOTS)]
     pilots: usize,
     /// Seed: the same seed gives the same image for any thread count.
     #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]

@@ -21,7 +21,8 @@ use crate::scene::analysis::SampleShear;
 use crate::scene::pixel::PixelIntegrand;
 use crate::scene::pixel_shear::{Measured, PixelShearOptions, search_pixel_shear};
 use crate::scene::render::{
-    PixelStatistics, ShearPolicy, analyse, pixel_shears, reference_image, render_variance,
+    DEFAULT_PILOTS, PixelStatistics, ShearPolicy, analyse, pixel_shears, reference_image,
+    render_variance,
 };
 
 /// Most samples per pixel a scene figure may ask for.
@@ -49,7 +50,12 @@ pub(super) const POLICIES: [(&str, ShearPolicy); 4] = [
     ("none", ShearPolicy::None),
     ("best global", ShearPolicy::Global(SampleShear::NONE)),
     ("per-pixel analytic", ShearPolicy::Analytic),
-    ("per-pixel pilot", ShearPolicy::Pilot { pilots: 8 }),
+    (
+        "per-pixel pilot",
+        ShearPolicy::Pilot {
+            pilots: DEFAULT_PILOTS,
+        },
+    ),
 ];
 
 /// Files of a pixel figure: `PREFIX.csv` and, per pixel,

@@ -21,11 +21,14 @@ pub enum ShearPolicy {
     None,
     /// One shear for every pixel.
     Global(SampleShear),
-    /// The shear following the depth the pixel's centre ray sees
-    /// ([`SampleShear::following`]).
+    /// The shear the pixel's analysis gives ([`PixelAnalysis::shear`]):
+    /// the warp of the depth its centre ray sees.
     Analytic,
-    /// Per pixel, the candidate (none, and the position shear and the warp
-    /// of every depth the probes met) with the lowest sample variance over
+    /// The analytic shear where the analysis is unambiguous (one depth:
+    /// there the warp of its slope is the light field's alignment to first
+    /// order), and on occlusion edges (two depths, which no single shear
+    /// aligns) the candidate (none, and the position shear and the warp of
+    /// every depth the probes met) with the lowest sample variance over
     /// `pilots` pilot estimates drawn from a stream independent of the
     /// render's.
     Pilot {
@@ -33,6 +36,13 @@ pub enum ShearPolicy {
         pilots: usize,
     },
 }
+
+/// Pilot estimates per candidate of [`ShearPolicy::Pilot`] by default.
+/// Measured on the dof scene at 64 spp (32 renders): mean pixel variance
+/// 5.47e-5 with 8, 5.36e-5 with 32, against 5.50e-5 for the analytic warp;
+/// a sample variance of 8 estimates is off by ~50%, too noisy to rank
+/// candidates whose variances differ by less.
+pub const DEFAULT_PILOTS: usize = 32;
 
 /// What is wrong with a render request.
 #[derive(Debug, thiserror::Error)]
@@ -106,8 +116,8 @@ pub fn pixel_shears(
                 .par_iter()
                 .enumerate()
                 .map(|(i, a)| {
-                    if a.kind == PixelKind::Background {
-                        return Ok(SampleShear::NONE);
+                    if a.kind != PixelKind::Edge {
+                        return Ok(a.shear());
                     }
                     let mut best = (SampleShear::NONE, f64::INFINITY);
                     let candidates = std::iter::once(SampleShear::NONE).chain(
