@@ -86,6 +86,22 @@ fn fraction_below(c0: f64, cx: f64, cu: f64, e: f64) -> f64 {
         .sum()
 }
 
+/// A defocused occluder (a constant quad at depth 2, focus 3) over a
+/// striped plane at depth 6, 8 × 8 pixels: its edge crosses column 4, the
+/// other columns see one depth.
+const OCCLUDER_SCENE: &str = r#"{
+  "camera": {"resolution": [8, 8], "fov_degrees": 30, "position": [0, 0, 0],
+             "look_at": [0, 0, -1], "focal_distance": 3, "aperture": 0.3},
+  "integrand": "lens",
+  "ambient": 1.0,
+  "objects": [
+    {"shape": "quad", "scale": [200, 200, 1], "translate": [0, 0, -6],
+     "material": {"texture": "stripes", "period": 0.7, "low": 0.1, "high": 0.9}},
+    {"shape": "quad", "scale": [10, 10, 1], "translate": [-9.95, 0, -2],
+     "material": {"texture": "constant", "albedo": 0.5}}
+  ]
+}"#;
+
 /// A plane at depth `depth` whose albedo is 1 left of world x = `edge` and
 /// 0 right of it (stripes of period 100: one boundary in view), focus at
 /// `focus`, lens half-side `aperture`, 8 × 8 pixels.
@@ -467,19 +483,7 @@ fn the_pixel_shear_search_picks_the_warp_of_a_defocused_edge_and_sees_double_wed
     // An occluder at depth 2 in front of the plane at 6 with its edge
     // across the pixel: two depths, a double wedge; no candidate may end
     // above no shear.
-    let json = r#"{
-  "camera": {"resolution": [8, 8], "fov_degrees": 30, "position": [0, 0, 0],
-             "look_at": [0, 0, -1], "focal_distance": 3, "aperture": 0.3},
-  "integrand": "lens",
-  "ambient": 1.0,
-  "objects": [
-    {"shape": "quad", "scale": [200, 200, 1], "translate": [0, 0, -6],
-     "material": {"texture": "stripes", "period": 0.7, "low": 0.1, "high": 0.9}},
-    {"shape": "quad", "scale": [10, 10, 1], "translate": [-9.95, 0, -2],
-     "material": {"texture": "constant", "albedo": 0.5}}
-  ]
-}"#;
-    let scene = Arc::new(Scene::from_text(json, "occluder").unwrap());
+    let scene = Arc::new(Scene::from_text(OCCLUDER_SCENE, "occluder").unwrap());
     let found =
         search_pixel_shear(&PixelIntegrand::new(scene, 4, 4), sampler.as_ref(), options).unwrap();
     assert!(
@@ -553,21 +557,7 @@ fn a_pixel_light_field_plane_matches_its_closed_form_marginal() {
 fn the_pilot_measures_only_occlusion_edges_and_pinhole_pixels_are_not_warped() {
     use varspec::scene::analysis::SampleShear;
     use varspec::scene::render::{ShearPolicy, analyse, pixel_shears};
-    // A defocused occluder (depth 2, focus 3) over a striped plane at 6:
-    // its edge crosses column 4, the other columns see one depth.
-    let json = r#"{
-  "camera": {"resolution": [8, 8], "fov_degrees": 30, "position": [0, 0, 0],
-             "look_at": [0, 0, -1], "focal_distance": 3, "aperture": 0.3},
-  "integrand": "lens",
-  "ambient": 1.0,
-  "objects": [
-    {"shape": "quad", "scale": [200, 200, 1], "translate": [0, 0, -6],
-     "material": {"texture": "stripes", "period": 0.7, "low": 0.1, "high": 0.9}},
-    {"shape": "quad", "scale": [10, 10, 1], "translate": [-9.95, 0, -2],
-     "material": {"texture": "constant", "albedo": 0.5}}
-  ]
-}"#;
-    let scene = Scene::from_text(json, "occluder").unwrap();
+    let scene = Scene::from_text(OCCLUDER_SCENE, "occluder").unwrap();
     let sampler = registry::build("umj", 16, Some(4), &[]).unwrap();
     let analysis = analyse(&scene);
     let analytic = pixel_shears(
