@@ -31,11 +31,10 @@ pub struct Args {
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'n', long, visible_alias = "n", default_value_t = 16)]
     spp: usize,
     /// Shear of each pixel's set: none; analytic (the warp following the
-    /// centre depth's light field); pilot (analytic on single-depth pixels; on occlusion edges the best
-    /// of none and every probed depth's shears by --pilots pilot
-    /// estimates); A (x′ = x + A·u,
-    /// y′ = y + A·v everywhere); warp:K (the footprint warp of slope K
-    /// everywhere).
+    /// centre depth's light field); pilot (analytic on single-depth pixels;
+    /// on occlusion edges the best of none and every probed depth's shears
+    /// by --pilots pilot estimates); A (x′ = x + A·u, y′ = y + A·v
+    /// everywhere); warp:K (the footprint warp of slope K everywhere).
     #[arg(long, default_value = "none", allow_hyphen_values = true)]
     shear: String,
     /// Pilot estimates per candidate shear (--shear pilot).
