@@ -14,8 +14,8 @@ use serde::{Deserialize, Serialize};
 
 use super::planes::{box_power, plane, plane_pngs};
 use super::scene_figures::{
-    MAX_RENDERS, MAX_SPP, POLICIES, REFERENCE_SAMPLER, pixel_files, scene_pixels, scene_samplers,
-    scene_variance,
+    MAX_RENDERS, MAX_SPP, POLICIES, REFERENCE_SAMPLER, lens_design_png, pixel_files, scene_pixels,
+    scene_samplers, scene_variance,
 };
 use super::spec::{ExperimentError, plain_name};
 use crate::design::projections::{ProjectionRequest, design_projections};
@@ -158,6 +158,8 @@ pub enum Figure {
     /// reference), `PREFIX-reference.pfm` (hash-scrambled Sobol', 2 renders at
     /// `reference_spp`) and the seed's variance heat maps at `heatmap_spp`:
     /// `PREFIX-variance-{none,per-pixel-analytic,per-pixel-pilot}.png`.
+    /// Each of `lens_designs` adds two rows (no shear, and the per-pixel
+    /// analytic warp, with its heat map `PREFIX-variance-lens-design-I.png`).
     SceneVariance {
         /// File name prefix.
         prefix: String,
@@ -165,6 +167,13 @@ pub enum Figure {
         scene: String,
         /// 4D sampler.
         sampler: String,
+        /// 4D samplers at the same N whose (u, v) pattern is chosen for the
+        /// warped integrand: the warp turns a single-depth pixel into a 2D
+        /// integral over the (u, v) pattern (docs/scene.md), so that
+        /// pattern decides what is left (e.g. a (0, 2)-net,
+        /// `padded:xy=mj,uv=sobol:scramble=hash`).
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        lens_designs: Vec<String>,
         /// Samples per pixel (each the sampler's nearest valid N).
         spp: Vec<usize>,
         /// Renders per policy and spp (at least 2).
@@ -249,11 +258,16 @@ impl Figure {
             | Figure::DesignedProjections { prefix, planes, .. } => {
                 planes.iter().map(|p| format!("{prefix}-{p}.png")).collect()
             }
-            Figure::SceneVariance { prefix, .. } => {
+            Figure::SceneVariance {
+                prefix,
+                lens_designs,
+                ..
+            } => {
                 let mut files = vec![format!("{prefix}.csv"), format!("{prefix}-reference.pfm")];
                 for (name, _) in POLICIES.iter().filter(|p| p.0 != "best global") {
                     files.push(format!("{prefix}-variance-{}.png", name.replace(' ', "-")));
                 }
+                files.extend((0..lens_designs.len()).map(|i| lens_design_png(prefix, i)));
                 files
             }
             Figure::SceneSamplers { file, .. } => vec![file.clone()],
@@ -374,6 +388,15 @@ impl FigureExperiment {
                 }
                 Ok(())
             };
+            // Names (samplers, scenes) given once each.
+            let given_once = |what: &str, list: &[String]| match list
+                .iter()
+                .enumerate()
+                .find(|(j, s)| list[..*j].contains(s))
+            {
+                Some((j, name)) => Err(at(format!("{what} `{name}` is given twice (at {j})"))),
+                None => Ok(()),
+            };
             match figure {
                 Figure::RadialSpectra {
                     samplers,
@@ -444,6 +467,7 @@ impl FigureExperiment {
                 Figure::SceneVariance {
                     scene,
                     sampler,
+                    lens_designs,
                     spp,
                     renders,
                     heatmap_spp,
@@ -464,6 +488,20 @@ impl FigureExperiment {
                         used.push((n, m));
                     }
                     distinct("spp", &used)?;
+                    for design in lens_designs {
+                        for &(n, m) in &used {
+                            let (_, k) = registry::build_nearest(design, m, Some(4), &[]).map_err(
+                                |err| at(format!("lens design `{design}` at n = {n}: {err}")),
+                            )?;
+                            if k != m {
+                                return Err(at(format!(
+                                    "lens design `{design}` takes {k} spp where `{sampler}` \
+                                     takes {m} (spp {n}): the rows compare equal spp"
+                                )));
+                            }
+                        }
+                    }
+                    given_once("lens design", lens_designs)?;
                     if !spp.contains(heatmap_spp) {
                         return Err(at(format!(
                             "heatmap_spp = {heatmap_spp} must be one of spp {spp:?}"
@@ -486,15 +524,8 @@ impl FigureExperiment {
                     if scenes.is_empty() || samplers.is_empty() {
                         return Err(at("scenes and samplers must be non-empty".into()));
                     }
-                    for (what, list) in [("scene", scenes), ("sampler", samplers)] {
-                        if let Some((j, name)) = list
-                            .iter()
-                            .enumerate()
-                            .find(|(j, s)| list[..*j].contains(s))
-                        {
-                            return Err(at(format!("{what} `{name}` is given twice (at {j})")));
-                        }
-                    }
+                    given_once("scene", scenes)?;
+                    given_once("sampler", samplers)?;
                     for scene in scenes {
                         Scene::load(scene).map_err(|err| at(err.to_string()))?;
                     }
@@ -804,6 +835,7 @@ impl FigureExperiment {
                 prefix,
                 scene,
                 sampler,
+                lens_designs,
                 spp,
                 renders,
                 heatmap_spp,
@@ -813,7 +845,7 @@ impl FigureExperiment {
                 out,
                 prefix,
                 scene,
-                sampler,
+                (sampler, lens_designs),
                 spp,
                 *renders,
                 (*heatmap_spp, *reference_spp),

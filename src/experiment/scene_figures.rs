@@ -80,8 +80,14 @@ fn table_error(what: &str, err: String) -> ExperimentError {
     }
 }
 
+/// File of the heat map of lens design `i` (0-based) at the heat-map spp.
+pub(super) fn lens_design_png(prefix: &str, i: usize) -> String {
+    format!("{prefix}-variance-lens-design-{}.png", i + 1)
+}
+
 /// The depth-of-field scene's per-pixel variance under the four
-/// [`POLICIES`] at each spp (see [`super::Figure::SceneVariance`]);
+/// [`POLICIES`] at each spp, and each lens design with no shear and with
+/// the per-pixel analytic warp (see [`super::Figure::SceneVariance`]);
 /// returns its README entry.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn scene_variance(
@@ -89,7 +95,7 @@ pub(super) fn scene_variance(
     out: &Path,
     prefix: &str,
     scene: &str,
-    sampler: &str,
+    (sampler, lens_designs): (&str, &[String]),
     spp: &[usize],
     renders: usize,
     (heatmap_spp, reference_spp): (usize, usize),
@@ -109,8 +115,8 @@ pub(super) fn scene_variance(
     }
     let mut rows: Vec<Vec<String>> = Vec::new();
     let mut table = String::from(
-        "| spp | policy | shear | mean variance | median | 95th percentile | MSE vs reference |\n\
-         |---|---|---|---|---|---|---|\n",
+        "| spp | sampler | policy | shear | mean variance | median | 95th percentile | MSE vs reference |\n\
+         |---|---|---|---|---|---|---|---|\n",
     );
     let mut gains = String::new();
     for &requested in spp {
@@ -132,54 +138,89 @@ pub(super) fn scene_variance(
                 best = (c, v);
             }
         }
+        // One row: the mean pixel variance of `policy` with sampler `s`,
+        // and its heat map when `png` gives one (file, and who in its
+        // title: a sampler's full name can be too long for one).
+        let mut row = |s: &dyn crate::samplers::Sampler,
+                       label: &str,
+                       name: &str,
+                       policy: ShearPolicy,
+                       png: Option<(String, String)>|
+         -> Result<f64, Box<dyn std::error::Error>> {
+            let shears = pixel_shears(&scene, s, policy, &analysis, seed)?;
+            let maps = render_variance(&scene, s, &shears, seed, renders, &|| {})?;
+            let mse = maps.mse_against(&reference);
+            let stats = PixelStatistics::of(&maps.variance.pixels);
+            let shear = match policy {
+                ShearPolicy::Global(c) => format!("{} {}", c.form(), c.amounts()[0]),
+                ShearPolicy::None => "none".into(),
+                _ => "per pixel".into(),
+            };
+            table += &format!(
+                "| {n} | {label} | {name} | {shear} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} |\n",
+                stats.mean, stats.median, stats.p95
+            );
+            rows.push(vec![
+                n.to_string(),
+                name.into(),
+                shear,
+                renders.to_string(),
+                format!("{:e}", stats.mean),
+                format!("{:e}", stats.median),
+                format!("{:e}", stats.p95),
+                format!("{mse:e}"),
+                label.into(),
+            ]);
+            if let Some((png, who)) = png.filter(|_| requested == heatmap_spp) {
+                maps.variance.write_variance_png(
+                    &format!(
+                        "{}, {who} {n} spp, {name}: per-pixel variance ({renders} renders)",
+                        scene.name()
+                    ),
+                    Some((-6.0, -2.0)),
+                    &out.join(png),
+                )?;
+            }
+            Ok(stats.mean)
+        };
         let mut means = Vec::new();
         for &(name, policy) in &POLICIES {
             let policy = match policy {
                 ShearPolicy::Global(_) => ShearPolicy::Global(best.0),
                 p => p,
             };
-            let shears = pixel_shears(&scene, s.as_ref(), policy, &analysis, seed)?;
-            let maps = render_variance(&scene, s.as_ref(), &shears, seed, renders, &|| {})?;
-            let mse = maps.mse_against(&reference);
-            let stats = PixelStatistics::of(&maps.variance.pixels);
-            let label = match policy {
-                ShearPolicy::Global(c) => format!("{} {}", c.form(), c.amounts()[0]),
-                ShearPolicy::None => "none".into(),
-                _ => "per pixel".into(),
-            };
-            table += &format!(
-                "| {n} | {name} | {label} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} |\n",
-                stats.mean, stats.median, stats.p95
-            );
-            rows.push(vec![
-                n.to_string(),
-                name.into(),
-                label,
-                renders.to_string(),
-                format!("{:e}", stats.mean),
-                format!("{:e}", stats.median),
-                format!("{:e}", stats.p95),
-                format!("{mse:e}"),
-            ]);
-            means.push(stats.mean);
-            if requested == heatmap_spp && name != "best global" {
-                maps.variance.write_variance_png(
-                    &format!(
-                        "{}, {sampler} {n} spp, {name}: per-pixel variance ({renders} renders)",
-                        scene.name()
-                    ),
-                    Some((-6.0, -2.0)),
-                    &out.join(format!("{prefix}-variance-{}.png", name.replace(' ', "-"))),
-                )?;
-            }
+            let png = (name != "best global").then(|| {
+                let file = format!("{prefix}-variance-{}.png", name.replace(' ', "-"));
+                (file, sampler.to_string())
+            });
+            means.push(row(s.as_ref(), sampler, name, policy, png)?);
         }
         gains += &format!(
             "- {n} spp: per-pixel analytic {:.2}× below none, {:.2}× below the best global shear; \
-             pilot {:.2}× below none.\n",
+             pilot {:.2}× below none",
             means[0] / means[2],
             means[1] / means[2],
             means[0] / means[3]
         );
+        for (i, design) in lens_designs.iter().enumerate() {
+            let (d, _) = registry::build_nearest(design, n, Some(4), &[])?;
+            let own = row(d.as_ref(), design, "none", ShearPolicy::None, None)?;
+            let png = Some((lens_design_png(prefix, i), format!("lens design {}", i + 1)));
+            let warped = row(
+                d.as_ref(),
+                design,
+                "per-pixel analytic",
+                ShearPolicy::Analytic,
+                png,
+            )?;
+            gains += &format!(
+                "; {design} with the per-pixel analytic warp {:.2}× below {sampler}'s none \
+                 ({:.2}× below its own)",
+                means[0] / warped,
+                own / warped
+            );
+        }
+        gains += ".\n";
     }
     write_csv(
         out,
@@ -193,12 +234,18 @@ pub(super) fn scene_variance(
             "median_variance",
             "p95_variance",
             "mse_vs_reference",
+            "sampler",
         ],
         &rows,
         &table_error,
     )?;
+    let designs: String = lens_designs
+        .iter()
+        .enumerate()
+        .map(|(i, d)| format!(", `{}` ({d})", lens_design_png(prefix, i)))
+        .collect();
     Ok(format!(
-        "- `{prefix}.csv`, `{prefix}-variance-{{none,per-pixel-analytic,per-pixel-pilot}}.png` \
+        "- `{prefix}.csv`, `{prefix}-variance-{{none,per-pixel-analytic,per-pixel-pilot}}.png`{designs} \
          (at {heatmap_spp} spp), `{prefix}-reference.pfm` (hash-scrambled Sobol' {reference_n} spp, 2 renders): \
          scene `{}` with {sampler}, per-pixel variance over {renders} renders, MSE against the \
          reference.\n\n{table}\n{gains}",
