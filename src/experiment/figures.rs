@@ -488,6 +488,12 @@ impl FigureExperiment {
                         used.push((n, m));
                     }
                     distinct("spp", &used)?;
+                    given_once("lens design", lens_designs)?;
+                    if lens_designs.contains(sampler) {
+                        return Err(at(format!(
+                            "lens design `{sampler}` is the sampler itself: its rows are there"
+                        )));
+                    }
                     for design in lens_designs {
                         for &(n, m) in &used {
                             let (_, k) = registry::build_nearest(design, m, Some(4), &[]).map_err(
@@ -501,7 +507,6 @@ impl FigureExperiment {
                             }
                         }
                     }
-                    given_once("lens design", lens_designs)?;
                     if !spp.contains(heatmap_spp) {
                         return Err(at(format!(
                             "heatmap_spp = {heatmap_spp} must be one of spp {spp:?}"

@@ -16,6 +16,7 @@ use crate::optimize::shear::SENSITIVITY_STEP;
 use crate::registry;
 use crate::report::plot::power_png;
 use crate::rng::set_rng;
+use crate::samplers::Sampler;
 use crate::scene::Scene;
 use crate::scene::analysis::SampleShear;
 use crate::scene::pixel::PixelIntegrand;
@@ -138,11 +139,11 @@ pub(super) fn scene_variance(
                 best = (c, v);
             }
         }
-        // One row: the mean pixel variance of `policy` with sampler `s`,
-        // and its heat map when `png` gives one (file, and who in its
-        // title: a sampler's full name can be too long for one).
-        let mut row = |s: &dyn crate::samplers::Sampler,
-                       label: &str,
+        // One row: the mean pixel variance of `policy` with sampler `s`
+        // (named `who`), and its heat map when `png` gives one (file, and
+        // who in its title: a sampler's full name can be too long for one).
+        let mut row = |s: &dyn Sampler,
+                       who: &str,
                        name: &str,
                        policy: ShearPolicy,
                        png: Option<(String, String)>|
@@ -157,7 +158,7 @@ pub(super) fn scene_variance(
                 _ => "per pixel".into(),
             };
             table += &format!(
-                "| {n} | {label} | {name} | {shear} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} |\n",
+                "| {n} | {who} | {name} | {shear} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} |\n",
                 stats.mean, stats.median, stats.p95
             );
             rows.push(vec![
@@ -169,12 +170,12 @@ pub(super) fn scene_variance(
                 format!("{:e}", stats.median),
                 format!("{:e}", stats.p95),
                 format!("{mse:e}"),
-                label.into(),
+                who.into(),
             ]);
-            if let Some((png, who)) = png.filter(|_| requested == heatmap_spp) {
+            if let Some((png, titled)) = png.filter(|_| requested == heatmap_spp) {
                 maps.variance.write_variance_png(
                     &format!(
-                        "{}, {who} {n} spp, {name}: per-pixel variance ({renders} renders)",
+                        "{}, {titled} {n} spp, {name}: per-pixel variance ({renders} renders)",
                         scene.name()
                     ),
                     Some((-6.0, -2.0)),
@@ -203,7 +204,8 @@ pub(super) fn scene_variance(
             means[0] / means[3]
         );
         for (i, design) in lens_designs.iter().enumerate() {
-            let (d, _) = registry::build_nearest(design, n, Some(4), &[])?;
+            let (d, m) = registry::build_nearest(design, n, Some(4), &[])?;
+            debug_assert_eq!(m, n, "validation compares the designs' N");
             let own = row(d.as_ref(), design, "none", ShearPolicy::None, None)?;
             let png = Some((lens_design_png(prefix, i), format!("lens design {}", i + 1)));
             let warped = row(

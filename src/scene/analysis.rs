@@ -71,9 +71,10 @@ impl PixelAnalysis {
     /// over a striped wall is 1.9× above the wall's slope); the pilot
     /// policy measures those pixels.
     pub fn shear(&self) -> SampleShear {
-        match self.kappa {
-            0.0 => SampleShear::NONE,
-            k => SampleShear::following(k),
+        if self.kappa == 0.0 {
+            SampleShear::NONE
+        } else {
+            SampleShear::following(self.kappa)
         }
     }
 }
