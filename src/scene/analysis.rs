@@ -62,20 +62,16 @@ pub struct PixelAnalysis {
 }
 
 impl PixelAnalysis {
-    /// The analytic sample shear: the warp following the centre depth's κ
-    /// ([`SampleShear::following`]); none where κ is 0: the background, a
-    /// pinhole, and the soft-shadow integrand, whose (u, v) are on the
-    /// light, not the lens. On an occlusion edge no single slope is right
+    /// The analytic sample shear: [`SampleShear::following`] the centre
+    /// depth's κ (0, so no shear, for the background, a pinhole, and the
+    /// soft-shadow integrand, whose (u, v) are on the light, not the lens).
+    /// On an occlusion edge no single slope is right
     /// for every scene (measured: the occluder's slope lowers the dof
     /// scene's sphere-edge pixels by 8% at 64 spp, but a constant occluder
     /// over a striped wall is 1.9× above the wall's slope); the pilot
     /// policy measures those pixels.
     pub fn shear(&self) -> SampleShear {
-        if self.kappa == 0.0 {
-            SampleShear::NONE
-        } else {
-            SampleShear::following(self.kappa)
-        }
+        SampleShear::following(self.kappa)
     }
 }
 
@@ -110,9 +106,15 @@ impl SampleShear {
     /// No shear.
     pub const NONE: SampleShear = SampleShear::Position([0.0, 0.0]);
 
-    /// The transformation that follows a light field of shear κ: the warp.
+    /// The transformation that follows a light field of shear κ: the warp;
+    /// none for an unsheared field (κ = 0), where the warp's limit would
+    /// exchange the position and lens coordinates ([`footprint_warp`]).
     pub fn following(kappa: f64) -> SampleShear {
-        SampleShear::Warp(kappa)
+        if kappa == 0.0 {
+            SampleShear::NONE
+        } else {
+            SampleShear::Warp(kappa)
+        }
     }
 
     /// `position` or `warp`.
