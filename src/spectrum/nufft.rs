@@ -359,18 +359,21 @@ impl NufftPlan {
         });
         self.fft(scratch, sign, Prune::Type2);
         // Interpolation only reads the grid: points in bin order, in
-        // parallel chunks, each value computed on its own.
+        // parallel chunks, each value computed on its own and written to
+        // its point's slot by the task that computed it.
         self.bin_order(points, &mut scratch.order);
         gather_sorted(points, None, &scratch.order.order, &mut scratch.sorted);
         let (order, grid, coords) = (&scratch.order.order, &scratch.grid, &scratch.sorted.0);
         let d = self.freqs.dim;
-        let values: Vec<Complex64> = with_width!(self.width, W => coords
-            .par_chunks(POINTS_PER_TASK * d)
-            .flat_map_iter(|chunk| self.interpolate_fastest::<W>(chunk, grid))
-            .collect());
-        for (&j, v) in order.iter().zip(values) {
-            out[j] = v;
-        }
+        let slots = Scatter::new(out);
+        with_width!(self.width, W => coords
+        .par_chunks(POINTS_PER_TASK * d)
+        .zip(order.par_chunks(POINTS_PER_TASK))
+        .for_each(|(chunk, indices)| {
+            for (&j, v) in indices.iter().zip(self.interpolate_fastest::<W>(chunk, grid)) {
+                slots.write(j, v);
+            }
+        }));
     }
 
     fn check(&self, points: &PointSet, modes: usize) {
@@ -561,7 +564,7 @@ impl NufftPlan {
                 for (s, &l) in slab[at..at + W * C].iter_mut().zip(lead) {
                     *s += weight * l;
                 }
-                if !next_cell::<W>(&mut a, d) {
+                if !next_cell::<W>(&mut a, 1, d) {
                     break;
                 }
             }
@@ -710,10 +713,14 @@ impl NufftPlan {
     }
 
     /// Σ_cells grid·ψ-weight around each point of `coords` (d per point):
-    /// the type-2 interpolation, for a kernel of width `W`. The rows of
-    /// the first axis are summed column by column (W independent sums the
-    /// compiler vectorises, read contiguously where the kernel does not
-    /// wrap), then weighted along the first axis.
+    /// the type-2 interpolation, for a kernel of width `W`. The kernel's rows
+    /// along the first axis, each weighted by the other axes' product, are
+    /// added column by column (2W independent real sums; a row is read
+    /// contiguously where the kernel does not wrap), then the columns are
+    /// weighted along the first axis. The W rows of axis 1 are a
+    /// fixed-length loop inside the odometer over the axes above, so the
+    /// columns stay in registers: inside a generic odometer they lived in
+    /// memory, and each row waited for the last one's stores.
     #[inline(always)]
     fn interpolate<const W: usize>(&self, coords: &[f64], grid: &[Complex64]) -> Vec<Complex64> {
         let (n, d) = (self.grid, self.freqs.dim);
@@ -724,36 +731,32 @@ impl NufftPlan {
         for x in coords.chunks_exact(d) {
             let (mut weights, mut first) = ([[0.0f64; W]; 4], [0i64; 4]);
             self.point_kernel::<W>(x, &mut weights, &mut first);
-            let wrapped =
-                |dim: usize, a: usize| (first[dim] + a as i64).rem_euclid(n as i64) as usize;
-            let contiguous = first[0] >= 0 && first[0] as usize + W <= n;
-            let mut columns = [zero; W];
-            // Odometer over axes 1..d.
-            let mut a = [0usize; 4];
-            loop {
-                let (mut base, mut weight) = (0usize, 1.0);
-                for dim in (1..d).rev() {
-                    base = base * n + wrapped(dim, a[dim]);
-                    weight *= weights[dim][a[dim]];
-                }
-                base *= n;
-                if contiguous {
-                    let start = base + first[0] as usize;
-                    for (c, g) in columns.iter_mut().zip(&grid[start..start + W]) {
-                        *c += g * weight;
+            let wrapped = |dim: usize, a: usize| wrap(first[dim] + a as i64, n);
+            let mut columns = [[0.0f64; 2]; MAX_WIDTH];
+            if d == 1 {
+                add_row::<W>(&mut columns, grid, (0, n), 1.0, first[0]);
+            } else {
+                // Odometer over axes 2..d; the W rows of axis 1 inside, a
+                // fixed-length loop.
+                let mut a = [0usize; 4];
+                loop {
+                    let (mut outer, mut outer_weight) = (0usize, 1.0);
+                    for dim in (2..d).rev() {
+                        outer = outer * n + wrapped(dim, a[dim]);
+                        outer_weight *= weights[dim][a[dim]];
                     }
-                } else {
-                    for (a0, c) in columns.iter_mut().enumerate() {
-                        *c += grid[base + wrapped(0, a0)] * weight;
+                    for (a1, &w1) in weights[1].iter().enumerate() {
+                        let base = (outer * n + wrapped(1, a1)) * n;
+                        add_row::<W>(&mut columns, grid, (base, n), outer_weight * w1, first[0]);
                     }
-                }
-                if !next_cell::<W>(&mut a, d) {
-                    break;
+                    if !next_cell::<W>(&mut a, 2, d) {
+                        break;
+                    }
                 }
             }
             let mut value = zero;
             for (c, &w0) in columns.iter().zip(&weights[0]) {
-                value += c * w0;
+                value += Complex64::new(c[0], c[1]) * w0;
             }
             values.push(value);
         }
@@ -872,6 +875,79 @@ impl NufftPlan {
     }
 }
 
+/// Grid index `i` of an axis of `n` cells taken periodically, for
+/// i ∈ [−n, 2n) (a kernel's cells around a coordinate in [0, 1)): one
+/// conditional wrap, not an integer division.
+#[inline(always)]
+fn wrap(i: i64, n: usize) -> usize {
+    let n = n as i64;
+    let i = if i < 0 { i + n } else { i };
+    (if i >= n { i - n } else { i }) as usize
+}
+
+/// Adds the kernel row of the fine grid (row offset `base`, first cell
+/// `first`, possibly wrapping) times `weight` onto `columns`, column by
+/// column (re and im apart). A row that does not wrap is read in whole AVX2
+/// registers (two cells): an odd width reads one cell more, whose column is
+/// never used.
+#[inline(always)]
+fn add_row<const W: usize>(
+    columns: &mut [[f64; 2]; MAX_WIDTH],
+    grid: &[Complex64],
+    (base, n): (usize, usize),
+    weight: f64,
+    first: i64,
+) {
+    let span = W.next_multiple_of(2);
+    if first >= 0 && first as usize + span <= n {
+        let start = base + first as usize;
+        for (c, g) in columns[..span].iter_mut().zip(&grid[start..start + span]) {
+            c[0] += g.re * weight;
+            c[1] += g.im * weight;
+        }
+    } else {
+        for (a0, c) in columns[..W].iter_mut().enumerate() {
+            let g = grid[base + wrap(first + a0 as i64, n)];
+            c[0] += g.re * weight;
+            c[1] += g.im * weight;
+        }
+    }
+}
+
+/// Writes into a slice from parallel tasks at indices that are, together, a
+/// permutation: the bin order's scatter of type-2 values back to their
+/// points, which would otherwise be one serial pass of random writes (a
+/// twentieth of the transform at a million points).
+struct Scatter<'a> {
+    slots: *mut Complex64,
+    len: usize,
+    _out: std::marker::PhantomData<&'a mut [Complex64]>,
+}
+
+// SAFETY: `write` is only called with distinct indices (a permutation, see
+// there), so no two tasks touch the same slot.
+unsafe impl Sync for Scatter<'_> {}
+
+impl<'a> Scatter<'a> {
+    fn new(out: &'a mut [Complex64]) -> Self {
+        Scatter {
+            slots: out.as_mut_ptr(),
+            len: out.len(),
+            _out: std::marker::PhantomData,
+        }
+    }
+
+    /// `out[j] = v`. Callers pass each index at most once over all tasks:
+    /// here, the entries of the bin order, a permutation of the points.
+    #[inline]
+    fn write(&self, j: usize, v: Complex64) {
+        assert!(j < self.len, "scatter index {j} beyond {}", self.len);
+        // SAFETY: in bounds (checked above), and no other task writes slot
+        // j (the indices are a permutation) while `out` is borrowed for 'a.
+        unsafe { self.slots.add(j).write(v) };
+    }
+}
+
 /// The points' indices in bin order, with the working memory that finds it.
 #[derive(Default)]
 struct BinOrder {
@@ -967,11 +1043,12 @@ impl SlabLayout {
     }
 }
 
-/// Advances the odometer `a` over the kernel's cells on axes 1..d (axis 0
-/// is run through inside); false when every cell has been visited.
+/// Advances the odometer `a` over the kernel's cells on axes `from`..d (the
+/// axes below are run through inside); false when every cell has been
+/// visited.
 #[inline(always)]
-fn next_cell<const W: usize>(a: &mut [usize; 4], d: usize) -> bool {
-    let mut dim = 1;
+fn next_cell<const W: usize>(a: &mut [usize; 4], from: usize, d: usize) -> bool {
+    let mut dim = from;
     while dim < d {
         a[dim] += 1;
         if a[dim] < W {
@@ -1062,10 +1139,16 @@ fn fold_line(out: &mut [Complex64], line: &[f64], pad: usize, comps: usize) {
 /// sums is checked in tests/spectrum_accuracy.rs.
 struct KernelPolynomial {
     width: usize,
-    /// Monomial coefficients, `coeffs[j * width + a]` for s^j of cell a.
+    /// Monomial coefficients, `coeffs[j * lanes + a]` for s^j of cell a,
+    /// each degree's row padded with zeros to `lanes` (the width rounded up
+    /// to whole vector registers), so Horner's rule runs on full registers.
     coeffs: Vec<f64>,
     degree: usize,
 }
+
+/// Values per vector register the kernel's lanes are padded to (AVX2's four
+/// f64).
+const LANES: usize = 4;
 
 impl KernelPolynomial {
     fn fit(width: usize, beta: f64, tolerance: f64) -> Option<Self> {
@@ -1104,9 +1187,17 @@ impl KernelPolynomial {
                 }
                 prev = std::mem::replace(&mut cur, next);
             }
+            let lanes = width.next_multiple_of(LANES);
+            let mut padded = vec![0.0; q * lanes];
+            for (row, values) in padded
+                .chunks_exact_mut(lanes)
+                .zip(coeffs.chunks_exact(width))
+            {
+                row[..width].copy_from_slice(values);
+            }
             let fit = KernelPolynomial {
                 width,
-                coeffs,
+                coeffs: padded,
                 degree,
             };
             let worst = (0..=2000)
@@ -1131,13 +1222,18 @@ impl KernelPolynomial {
     fn eval(&self, s: f64, out: &mut [f64]) {
         let w = out.len();
         debug_assert_eq!(w, self.width);
-        out.copy_from_slice(&self.coeffs[self.degree * w..(self.degree + 1) * w]);
+        // Fixed-length loops over whole registers where `out` is an array.
+        let lanes = w.next_multiple_of(LANES);
+        let mut acc = [0.0; MAX_WIDTH.next_multiple_of(LANES)];
+        let acc = &mut acc[..lanes];
+        acc.copy_from_slice(&self.coeffs[self.degree * lanes..(self.degree + 1) * lanes]);
         for j in (0..self.degree).rev() {
-            let c = &self.coeffs[j * w..(j + 1) * w];
-            for (o, &cj) in out.iter_mut().zip(c) {
+            let c = &self.coeffs[j * lanes..(j + 1) * lanes];
+            for (o, &cj) in acc.iter_mut().zip(c) {
                 *o = *o * s + cj;
             }
         }
+        out.copy_from_slice(&acc[..w]);
     }
 }
 
