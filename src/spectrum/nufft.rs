@@ -371,7 +371,10 @@ impl NufftPlan {
         .zip(order.par_chunks(POINTS_PER_TASK))
         .for_each(|(chunk, indices)| {
             for (&j, v) in indices.iter().zip(self.interpolate_fastest::<W>(chunk, grid)) {
-                slots.write(j, v);
+                // SAFETY: `order` is a permutation of the points (a
+                // stable counting sort places each index once), and
+                // the chunks split it: every slot is written once.
+                unsafe { slots.write(j, v) };
             }
         }));
     }
@@ -715,8 +718,8 @@ impl NufftPlan {
     /// Σ_cells grid·ψ-weight around each point of `coords` (d per point):
     /// the type-2 interpolation, for a kernel of width `W`. The kernel's rows
     /// along the first axis, each weighted by the other axes' product, are
-    /// added column by column (2W independent real sums; a row is read
-    /// contiguously where the kernel does not wrap), then the columns are
+    /// added column by column (independent real sums, two per column; see
+    /// [`add_row`] for how a row is read), then the columns are
     /// weighted along the first axis. The W rows of axis 1 are a
     /// fixed-length loop inside the odometer over the axes above, so the
     /// columns stay in registers: inside a generic odometer they lived in
@@ -734,7 +737,7 @@ impl NufftPlan {
             let wrapped = |dim: usize, a: usize| wrap(first[dim] + a as i64, n);
             let mut columns = [[0.0f64; 2]; MAX_WIDTH];
             if d == 1 {
-                add_row::<W>(&mut columns, grid, (0, n), 1.0, first[0]);
+                add_row::<W>(&mut columns, grid, (0, first[0], n), 1.0);
             } else {
                 // Odometer over axes 2..d; the W rows of axis 1 inside, a
                 // fixed-length loop.
@@ -747,7 +750,7 @@ impl NufftPlan {
                     }
                     for (a1, &w1) in weights[1].iter().enumerate() {
                         let base = (outer * n + wrapped(1, a1)) * n;
-                        add_row::<W>(&mut columns, grid, (base, n), outer_weight * w1, first[0]);
+                        add_row::<W>(&mut columns, grid, (base, first[0], n), outer_weight * w1);
                     }
                     if !next_cell::<W>(&mut a, 2, d) {
                         break;
@@ -881,22 +884,23 @@ impl NufftPlan {
 #[inline(always)]
 fn wrap(i: i64, n: usize) -> usize {
     let n = n as i64;
+    debug_assert!((-n..2 * n).contains(&i), "cell {i} beyond one wrap of {n}");
     let i = if i < 0 { i + n } else { i };
     (if i >= n { i - n } else { i }) as usize
 }
 
 /// Adds the kernel row of the fine grid (row offset `base`, first cell
-/// `first`, possibly wrapping) times `weight` onto `columns`, column by
-/// column (re and im apart). A row that does not wrap is read in whole AVX2
-/// registers (two cells): an odd width reads one cell more, whose column is
-/// never used.
+/// `first` of a row of `n` cells, possibly wrapping) times `weight` onto
+/// `columns`, column by column (re and im apart). A row whose `span` cells
+/// (the width rounded up to whole AVX2 registers of two cells) fit without
+/// wrapping is read contiguously, an odd width's extra cell landing in a
+/// column that is never used; other rows cell by cell.
 #[inline(always)]
 fn add_row<const W: usize>(
     columns: &mut [[f64; 2]; MAX_WIDTH],
     grid: &[Complex64],
-    (base, n): (usize, usize),
+    (base, first, n): (usize, i64, usize),
     weight: f64,
-    first: i64,
 ) {
     let span = W.next_multiple_of(2);
     if first >= 0 && first as usize + span <= n {
@@ -924,8 +928,8 @@ struct Scatter<'a> {
     _out: std::marker::PhantomData<&'a mut [Complex64]>,
 }
 
-// SAFETY: `write` is only called with distinct indices (a permutation, see
-// there), so no two tasks touch the same slot.
+// SAFETY: `write` is unsafe and requires distinct indices over all tasks,
+// so no two tasks touch the same slot.
 unsafe impl Sync for Scatter<'_> {}
 
 impl<'a> Scatter<'a> {
@@ -937,13 +941,17 @@ impl<'a> Scatter<'a> {
         }
     }
 
-    /// `out[j] = v`. Callers pass each index at most once over all tasks:
-    /// here, the entries of the bin order, a permutation of the points.
+    /// `out[j] = v`.
+    ///
+    /// # Safety
+    /// No other call, from any task, may write index `j` while `out` is
+    /// borrowed (here: the entries of the bin order, a permutation of the
+    /// points, each written once).
     #[inline]
-    fn write(&self, j: usize, v: Complex64) {
+    unsafe fn write(&self, j: usize, v: Complex64) {
         assert!(j < self.len, "scatter index {j} beyond {}", self.len);
-        // SAFETY: in bounds (checked above), and no other task writes slot
-        // j (the indices are a permutation) while `out` is borrowed for 'a.
+        // SAFETY: in bounds (checked above); no other call writes slot j
+        // (the caller's contract) while `out` is borrowed for 'a.
         unsafe { self.slots.add(j).write(v) };
     }
 }
