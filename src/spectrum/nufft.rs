@@ -557,8 +557,7 @@ impl NufftPlan {
                     base = (first[d - 1] + a[d - 1] as i64 - origin) as usize;
                     weight = weights[d - 1][a[d - 1]];
                     for dim in (1..d - 1).rev() {
-                        base =
-                            base * n as usize + (first[dim] + a[dim] as i64).rem_euclid(n) as usize;
+                        base = base * n as usize + wrap(first[dim] + a[dim] as i64, n as usize);
                         weight *= weights[dim][a[dim]];
                     }
                     base *= layout.line;
@@ -1179,13 +1178,15 @@ impl KernelPolynomial {
             }
             // T_j in monomials: T_0 = 1, T_1 = s, T_(j+1) = 2s·T_j − T_(j−1)
             // (integer coefficients, exact in f64 at these degrees).
-            let mut coeffs = vec![0.0; q * width];
+            // Rows of `lanes` values, the cells past the width left zero.
+            let lanes = width.next_multiple_of(LANES);
+            let mut coeffs = vec![0.0; q * lanes];
             let (mut prev, mut cur) = (vec![0.0; q], vec![0.0; q]);
             cur[0] = 1.0;
             for j in 0..q {
                 for (k, &t) in cur.iter().enumerate().take(j + 1) {
                     for a in 0..width {
-                        coeffs[k * width + a] += cheb[j * width + a] * t;
+                        coeffs[k * lanes + a] += cheb[j * width + a] * t;
                     }
                 }
                 let factor = if j == 0 { 1.0 } else { 2.0 };
@@ -1195,17 +1196,9 @@ impl KernelPolynomial {
                 }
                 prev = std::mem::replace(&mut cur, next);
             }
-            let lanes = width.next_multiple_of(LANES);
-            let mut padded = vec![0.0; q * lanes];
-            for (row, values) in padded
-                .chunks_exact_mut(lanes)
-                .zip(coeffs.chunks_exact(width))
-            {
-                row[..width].copy_from_slice(values);
-            }
             let fit = KernelPolynomial {
                 width,
-                coeffs: padded,
+                coeffs,
                 degree,
             };
             let worst = (0..=2000)
