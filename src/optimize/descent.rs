@@ -11,6 +11,7 @@
 //!
 //! The step is the shared Adam descent of [`super::adam`].
 
+use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
 
 use super::adam::{
@@ -243,7 +244,7 @@ impl PointOptimizer {
 
     fn loss_of(&self, s: &[Complex64], n: usize) -> f64 {
         let n2 = (n * n) as f64;
-        crate::sum::sum(s.iter().zip(&self.weights).map(|(v, w)| w * v.norm_sqr())) / n2
+        crate::sum::par_sum(s.len(), |i| self.weights[i] * s[i].norm_sqr()) / n2
     }
 
     /// Loss and gradient (point-major, d per point) at `points`.
@@ -260,21 +261,28 @@ impl PointOptimizer {
         let mut grad = vec![0.0; n * d];
         let scale = 2.0 / (n * n) as f64;
         let tau = std::f64::consts::TAU;
-        let mut k = vec![0i64; d];
+        let spectrum = &work.spectrum;
         for pair in (0..d).step_by(2) {
-            for (idx, c) in work.coeffs.iter_mut().enumerate() {
-                self.freqs.frequency(idx, &mut k);
-                let base = work.spectrum[idx].conj() * self.weights[idx];
-                // −2πi·k_d: the first dimension of the pair in the real part,
-                // the second (if any) in the imaginary part.
-                let first = base * Complex64::new(0.0, -tau * k[pair] as f64);
-                let second = if pair + 1 < d {
-                    base * Complex64::new(0.0, -tau * k[pair + 1] as f64)
-                } else {
-                    Complex64::new(0.0, 0.0)
-                };
-                *c = first + Complex64::new(0.0, 1.0) * second;
-            }
+            work.coeffs
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(1 << 12)
+                .for_each_init(
+                    || vec![0i64; d],
+                    |k, (idx, c)| {
+                        self.freqs.frequency(idx, k);
+                        let base = spectrum[idx].conj() * self.weights[idx];
+                        // −2πi·k_d: the first dimension of the pair in the
+                        // real part, the second (if any) in the imaginary.
+                        let first = base * Complex64::new(0.0, -tau * k[pair] as f64);
+                        let second = if pair + 1 < d {
+                            base * Complex64::new(0.0, -tau * k[pair + 1] as f64)
+                        } else {
+                            Complex64::new(0.0, 0.0)
+                        };
+                        *c = first + Complex64::new(0.0, 1.0) * second;
+                    },
+                );
             self.plan.type2(
                 points,
                 &work.coeffs,
