@@ -1030,10 +1030,10 @@ const POINTS_PER_TASK: usize = 4096;
 /// Rows of the mode box one task copies into or out of the fine grid.
 const MODE_ROWS_PER_TASK: usize = 16;
 /// Lines an FFT pass gathers and scatters together along a strided axis (a
-/// power of two): 16 cells of each line per pass over 16 rows, 256-byte
-/// runs of the rows, measured 2.2× faster than one line at a time on a
-/// 1024² grid, whose power-of-two stride maps a line's cells to one cache
-/// set (4 at a time was slower than 1, 64 slower than 16).
+/// power of two): each grid row then gives a 256-byte run, not one cell.
+/// In a stand-alone transpose of a 1024² grid, whose power-of-two stride
+/// maps a line's cells to one cache set, 16 at a time was 2.2× faster than
+/// one (4 at a time was slower than 1, 64 slower than 16).
 const LINE_BLOCK: usize = 16;
 
 /// Which lines a pruned FFT may skip.
