@@ -889,10 +889,12 @@ impl NufftPlan {
         buf.par_chunks_mut(n * LINE_BLOCK)
             .enumerate()
             .for_each(|(block, chunk)| {
-                let first = block * LINE_BLOCK;
-                let bases: Vec<usize> = (first..first + chunk.len() / n)
-                    .map(|l| outer[l / inner.len()] * stride * n + inner[l % inner.len()])
-                    .collect();
+                let mut bases = [0usize; LINE_BLOCK];
+                let bases = &mut bases[..chunk.len() / n];
+                for (b, base) in bases.iter_mut().enumerate() {
+                    let l = block * LINE_BLOCK + b;
+                    *base = outer[l / inner.len()] * stride * n + inner[l % inner.len()];
+                }
                 for t in 0..n {
                     for (b, &base) in bases.iter().enumerate() {
                         chunk[b * n + t] = grid[base + t * stride];
