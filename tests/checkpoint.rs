@@ -3,7 +3,7 @@
 //! a process killed with SIGKILL continues from its last save; damaged
 //! checkpoints and checkpoints of another run are refused by name.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 use std::sync::Mutex;

@@ -1,7 +1,7 @@
 //! The command line as scripts use it: determinism across thread counts,
 //! exit codes and messages on bad input, the sampler list, pictures.
 
-mod common;
+use crate::common;
 use common::{temp_dir, varspec, varspec_with};
 
 #[test]

@@ -3,7 +3,7 @@
 use std::path::Path;
 use std::process::Output;
 
-mod common;
+use crate::common;
 use common::{temp_dir, varspec, varspec_with};
 
 fn s(p: &Path) -> &str {

@@ -1,7 +1,7 @@
 //! `varspec predict`, `converge`, `integrands` and `experiment` as scripts
 //! use them: the JSON keys of docs/cli.md, errors, determinism.
 
-mod common;
+use crate::common;
 use common::{varspec, varspec_with};
 
 fn json(args: &[&str]) -> serde_json::Value {

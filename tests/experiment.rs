@@ -2,7 +2,7 @@
 //! (for any split), names that would escape the output folder are refused,
 //! and a rerun leaves no stale file.
 
-mod common;
+use crate::common;
 
 use common::{assert_fails, temp_dir, varspec};
 

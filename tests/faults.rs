@@ -3,7 +3,7 @@
 //! killed run's temporary file; an address-space limit lowers the memory
 //! budget so a request beyond it is refused instead of aborting.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 use std::time::Duration;

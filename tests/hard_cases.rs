@@ -2,7 +2,7 @@
 //! parameters give finite, non-negative variances on which the predictors
 //! agree, or a stated reason why one does not apply.
 
-mod common;
+use crate::common;
 
 use varspec::PointSet;
 use varspec::integrands;

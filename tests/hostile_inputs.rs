@@ -3,7 +3,7 @@
 //! the row's phrase, never panics or aborts, and a failed command writes no
 //! file. results/hostile-inputs.md shows what each input answers.
 
-mod common;
+use crate::common;
 
 use common::hostile::{cases, run, write_fixtures};
 

@@ -4,7 +4,7 @@
 //! Statistical checks use fixed seeds and two-sided 99.9% intervals
 //! (z = 3.29); each message prints the interval.
 
-mod common;
+use crate::common;
 
 use varspec::integrands;
 use varspec::registry;

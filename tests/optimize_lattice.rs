@@ -3,7 +3,7 @@
 //! the choice between a descent and its start, and the goal of issue 8 §2
 //! on half-planes no default was tuned on.
 
-mod common;
+use crate::common;
 
 use varspec::integrands;
 use varspec::optimize::adapted::{design_sets, keep_lower_variance};

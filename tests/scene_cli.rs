@@ -1,7 +1,7 @@
 //! `varspec render` as users run it: identical images for any thread count,
 //! every output written, scene files refused with the field named.
 
-mod common;
+use crate::common;
 use common::{assert_fails, temp_dir, varspec_with};
 
 #[test]

@@ -9,7 +9,7 @@
 //!   random-like samplers is skewed, so its mean needs many sets before a
 //!   normal interval holds).
 
-mod common;
+use crate::common;
 
 use rayon::prelude::*;
 use varspec::PointSet;

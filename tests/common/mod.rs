@@ -1,5 +1,5 @@
-//! Helpers shared by the command-line test files (each test file is its own
-//! crate and uses a subset, hence the `dead_code` allowance).
+//! Helpers shared by the test files (the suite and the fuzz binary, each
+//! its own crate, use subsets, hence the `dead_code` allowance).
 #![allow(dead_code)]
 
 use std::path::PathBuf;
