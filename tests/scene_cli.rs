@@ -286,3 +286,47 @@ fn npy_images_are_height_by_width_top_row_first() {
     assert_ne!(values, flipped, "an image equal to its flip tells nothing");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--shear warp:0` follows an unsheared light field: the same image as
+/// `--shear none` (the warp of slope 0 itself would exchange the position
+/// and lens coordinates), while a nonzero slope changes it.
+#[test]
+fn a_warp_of_slope_zero_is_no_shear() {
+    let dir = temp_dir("render-warp0");
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/dof.json")).unwrap();
+    let small = text.replace("\"resolution\": [256, 256]", "\"resolution\": [24, 16]");
+    assert_ne!(text, small);
+    std::fs::write(dir.join("small.json"), small).unwrap();
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let render = |shear: &str| {
+        let out = varspec_with(
+            &[
+                "render",
+                &p("small.json"),
+                "--spp",
+                "16",
+                "--shear",
+                shear,
+                "-o",
+                &p("img.png"),
+                "--pfm",
+                &p("img.pfm"),
+            ],
+            None,
+        );
+        assert!(
+            out.status.success(),
+            "{shear}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read(dir.join("img.pfm")).unwrap()
+    };
+    let none = render("none");
+    assert!(render("warp:0") == none, "warp:0 differs from no shear");
+    assert!(
+        render("warp:0.5") != none,
+        "a warp of slope 0.5 changed nothing"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

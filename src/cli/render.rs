@@ -116,7 +116,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 None => (false, text),
             };
             match number.parse::<f64>() {
-                Ok(s) if s.is_finite() && warp => ShearPolicy::Global(SampleShear::Warp(s)),
+                // The warp of slope 0 would exchange position and lens
+                // coordinates; following an unsheared field is no shear.
+                Ok(s) if s.is_finite() && warp => ShearPolicy::Global(SampleShear::following(s)),
                 Ok(s) if s.is_finite() => ShearPolicy::Global(SampleShear::Position([s, s])),
                 _ => bail!(
                     "--shear {text}: expected none, analytic, pilot, a finite number A or warp:K"

@@ -142,8 +142,8 @@ pub fn search_pixel_shear(
     let chosen = lowest(&candidates);
     let sensitivity = match candidates[chosen].shear {
         SampleShear::Warp(k) => Some([
-            measure(SampleShear::Warp(k - SENSITIVITY_STEP), realizations)?,
-            measure(SampleShear::Warp(k + SENSITIVITY_STEP), realizations)?,
+            measure(SampleShear::following(k - SENSITIVITY_STEP), realizations)?,
+            measure(SampleShear::following(k + SENSITIVITY_STEP), realizations)?,
         ]),
         SampleShear::Position(_) => None,
     };
