@@ -69,6 +69,7 @@ fn the_lower_exact_variance_is_kept() {
         best_score: 0.5,
         start_score: 1.0,
         coarse_iterations: 0,
+        stop: varspec::optimize::Stop::Converged,
     };
     let kept = keep_lower_variance(good.clone(), result(&bad), f.as_ref()).unwrap();
     let e = kept.exact.unwrap();

@@ -144,3 +144,41 @@ fn optimization_is_deterministic_and_descends() {
     let best = a.losses.iter().copied().fold(f64::INFINITY, f64::min);
     assert!(best < 0.5 * a.losses[0], "loss {} -> {best}", a.losses[0]);
 }
+
+/// The descent says why it stopped: the rule's convergence, the accuracy
+/// floor, or the iteration cap (a capped run is not called converged).
+#[test]
+fn the_descent_reports_why_it_stopped() {
+    use varspec::optimize::{AdamOptions, Domain, PointObjective, Stop, adam};
+    /// 1 + Σ (x − 0.3)²: a minimum of 1, so relative improvements vanish.
+    struct Bowl;
+    impl PointObjective for Bowl {
+        fn loss_and_gradient(&self, p: &PointSet, _: usize, g: &mut [f64]) -> f64 {
+            for (gi, x) in g.iter_mut().zip(p.coords()) {
+                *gi = 2.0 * (x - 0.3);
+            }
+            1.0 + p.coords().iter().map(|x| (x - 0.3).powi(2)).sum::<f64>()
+        }
+    }
+    let start = PointSet::new(2, vec![0.9, 0.8, 0.1, 0.6, 0.7, 0.2]).unwrap();
+    let run = |iters: usize, rel_tol: f64, floor: f64| {
+        let o = AdamOptions {
+            iters,
+            rel_tol,
+            step: 0.05,
+            final_step: 0.002,
+            score_every: 1,
+            floor,
+        };
+        adam(start.clone(), &Bowl, &o, Domain::Torus, &|_, _| {})
+    };
+    let converged = run(100_000, 1e-6, 0.0);
+    assert_eq!(converged.stop, Stop::Converged);
+    assert!(converged.losses.len() < 100_000 && converged.best_score < 1.0 + 1e-3);
+    let capped = run(20, 1e-6, 0.0);
+    assert_eq!(capped.stop, Stop::Cap);
+    assert_eq!(capped.losses.len(), 20);
+    let floored = run(100_000, 0.0, 1.2);
+    assert_eq!(floored.stop, Stop::Floor);
+    assert!(floored.best_score <= 1.2 && floored.losses.len() > 1);
+}

@@ -13,6 +13,7 @@ use serde_json::json;
 use super::DesignRun;
 use crate::baseline::{Baseline, classic_baselines};
 use crate::integrands::Integrand;
+use crate::optimize::adam::Stop;
 use crate::optimize::adapted::{CheckpointPlan, Kept, design_sets};
 use crate::optimize::lattice::{LatticeDesign, best_lattice};
 use crate::optimize::{DescentOptions, OptimizeError, PointOptimizer, Target};
@@ -47,8 +48,10 @@ pub struct TorusRequest {
     pub upsampling: Option<Upsampling>,
     /// Box resolution K (|k| < K/2).
     pub res: Option<usize>,
-    /// Descend on a quarter box first (2D blue-noise targets).
-    pub coarse: bool,
+    /// Descend on a quarter box first (2D blue-noise targets): `None` as
+    /// [`DescentOptions::for_target`] decides (from
+    /// [`crate::optimize::descent::COARSE_FROM`] points on).
+    pub coarse: Option<bool>,
 }
 
 /// A checked plan: everything decided, nothing run.
@@ -90,6 +93,8 @@ pub struct TorusDesign {
     pub iterations: Vec<usize>,
     /// Iterations on the coarse box per set.
     pub coarse_iterations: Vec<usize>,
+    /// Why each set's descent stopped (converged, accuracy floor or cap).
+    pub stopped: Vec<Stop>,
     /// What the loss is.
     pub loss: &'static str,
     /// Set 0's loss per iteration.
@@ -181,13 +186,16 @@ impl TorusPlan {
             }
             options.half = (res - 1) / 2;
         }
-        if r.coarse {
-            if r.dim != 2 || matches!(target, Target::Integrand(_)) {
+        match r.coarse {
+            Some(true) if r.dim != 2 || matches!(target, Target::Integrand(_)) => {
                 return Err(OptimizeError::Option(
                     "--coarse applies to 2D blue-noise targets (family:, power:, radial:), not to integrand targets or other dimensions".into(),
                 ));
             }
-            options.coarse_half = Some(options.half / 4);
+            Some(true) => options.coarse_half = Some(options.half / 4),
+            Some(false) => options.coarse_half = None,
+            // A box given by --res: the coarse phase is a quarter of it.
+            None => options.coarse_half = options.coarse_half.map(|_| options.half / 4),
         }
         let (tolerance, rel_tol, coarse_half) =
             (options.tolerance, options.rel_tol, options.coarse_half);
@@ -210,7 +218,11 @@ impl TorusPlan {
         // sixteenth of the box), each running descent, the kept results, and
         // the classic samplers' sets of the comparison (measured at
         // N = 1,048,576 with --coarse: peak 525 MiB against 661 MiB stated).
-        let coarse_bytes = if r.coarse { plan_bytes / 16.0 } else { 0.0 };
+        let coarse_bytes = if coarse_half.is_some() {
+            plan_bytes / 16.0
+        } else {
+            0.0
+        };
         let baseline_bytes = r.sets.max(8) as f64 * r.n as f64 * r.dim as f64 * 8.0;
         let memory_bytes = plan_bytes
             + coarse_bytes
@@ -284,7 +296,7 @@ impl TorusPlan {
             self.tolerance,
             self.rel_tol,
             self.optimizer.upsampling(),
-            r.coarse,
+            self.coarse_half.is_some(),
         )
     }
 
@@ -350,6 +362,7 @@ impl TorusPlan {
             upsampling: self.optimizer.upsampling(),
             iterations: results.iter().map(|k| k.descent.losses.len()).collect(),
             coarse_iterations: results.iter().map(|k| k.descent.coarse_iterations).collect(),
+            stopped: results.iter().map(|k| k.descent.stop).collect(),
             loss: "sum over 0 < |k|inf <= half of W(k) P_S(k)  (for an integrand target: its predicted variance within the box)",
             loss_curve: results[0].descent.losses.clone(),
             loss_curve_seconds: results[0].descent.seconds.clone(),

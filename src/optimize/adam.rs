@@ -68,6 +68,29 @@ pub struct AdamOptions {
     pub floor: f64,
 }
 
+/// Why a descent stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stop {
+    /// The score improved by less than `rel_tol` over 50 scored iterations.
+    Converged,
+    /// The score reached the objective's accuracy floor.
+    Floor,
+    /// The iteration cap came first: not converged by the rule.
+    Cap,
+}
+
+impl Stop {
+    /// A phrase for a summary line.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Stop::Converged => "converged",
+            Stop::Floor => "at the transform's accuracy floor",
+            Stop::Cap => "iteration cap, not converged",
+        }
+    }
+}
+
 /// The optimized set and how it got there.
 #[derive(Debug, Clone)]
 pub struct DescentResult {
@@ -84,6 +107,8 @@ pub struct DescentResult {
     /// Iterations of a coarse first phase run before `losses` began (0:
     /// none; see [`super::descent::DescentOptions::coarse_half`]).
     pub coarse_iterations: usize,
+    /// Why the descent stopped.
+    pub stop: Stop,
 }
 
 /// Everything the descent needs to go on from iteration `t`: positions,
@@ -203,6 +228,7 @@ pub fn adam_from(
     let offset = s.seconds.last().copied().unwrap_or(s.seconds_offset);
     let clock = std::time::Instant::now();
     let mut last_save = clock;
+    let mut stop = Stop::Cap;
     while s.t < o.iters {
         let t = s.t;
         if let Some(c) = checkpointing
@@ -245,9 +271,11 @@ pub fn adam_from(
             }
             let k = s.scores.len();
             if score <= o.floor {
+                stop = Stop::Floor;
                 break;
             }
             if o.rel_tol > 0.0 && k > 50 && s.scores[k - 51] - score < o.rel_tol * score {
+                stop = Stop::Converged;
                 break;
             }
         }
@@ -283,5 +311,6 @@ pub fn adam_from(
         best_score: s.best_score,
         start_score: s.start_score,
         coarse_iterations: 0,
+        stop,
     }
 }

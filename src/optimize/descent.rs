@@ -43,11 +43,9 @@ pub struct DescentOptions {
     /// whose descent then starts at a fifth of `step` (the points are
     /// already spaced). The small box fixes the start's large-scale density
     /// fluctuations at a fraction of the cost per step (21 ms against 72 ms
-    /// at N = 65,536). `None` (the default): one phase. Measured from random
-    /// starts toward `family:disks` (results/optimize-blue-noise): lower
-    /// losses at N = 1024 to 65,536 (0.85× CMJ's at 65,536 against 1.03×),
-    /// but on unseen boxes at N = 1024 it scores worse (1.07× CMJ against
-    /// 1.02×), so it is an option, not the default.
+    /// at N = 65,536). `None`: one phase. The default from
+    /// [`DescentOptions::for_target`]: a quarter of the box for 2D
+    /// blue-noise targets from [`COARSE_FROM`] points on.
     pub coarse_half: Option<usize>,
     /// The NUFFT's upsampling factor: [`Upsampling::Auto`] for the set's
     /// size by default (σ = 5/4 below about 200,000 points in 2D, where it
@@ -57,6 +55,15 @@ pub struct DescentOptions {
 
 /// Iteration cap of the coarse phase.
 pub const COARSE_ITERS: usize = 300;
+
+/// Fewest points at which 2D blue-noise descents go coarse-to-fine by
+/// default. From random starts toward `family:disks`, scored on 24 disks
+/// and 24 boxes nobody tuned for (examples/torus_scores.rs,
+/// results/optimize-blue-noise): coarse-to-fine against one phase, mean
+/// variance relative to CMJ, 0.965× against 0.972× at N = 4096, 0.972×
+/// against 0.994× at 16,384, 1.057× against 1.110× at 65,536; at N = 1024
+/// it scored worse (0.992× against 0.973×), so smaller sets keep one phase.
+pub const COARSE_FROM: usize = 4096;
 
 impl DescentOptions {
     /// Defaults for N points in d dimensions and `target`. The box must hold
@@ -70,7 +77,8 @@ impl DescentOptions {
     /// the box and reached 0.30× CMJ, 256 reaches 0.21× (results/optimize-adapted).
     /// In 3D and 4D the box holds (2K+1)^d frequencies and the transform
     /// (4K)^d cells per thread, so K is capped at 40 and 12 (4D, K = 12:
-    /// about 0.4 GB on 2 threads; K = 32 asked for 9 GB).
+    /// about 0.4 GB on 2 threads; K = 32 asked for 9 GB). 2D blue-noise
+    /// targets of [`COARSE_FROM`] points or more descend coarse-to-fine.
     pub fn for_target(n: usize, dim: usize, target: &Target) -> Self {
         let root = (n as f64).powf(1.0 / dim as f64);
         let half = match target {
@@ -89,7 +97,8 @@ impl DescentOptions {
             rel_tol: 1e-4,
             step: 0.05,
             final_step: 0.002,
-            coarse_half: None,
+            coarse_half: (dim == 2 && !matches!(target, Target::Integrand(_)) && n >= COARSE_FROM)
+                .then_some(half / 4),
             upsampling: Upsampling::Auto { points: n },
         }
     }

@@ -13,7 +13,8 @@ pub mod shear;
 pub mod target;
 
 pub use adam::{
-    AdamOptions, AdamState, Checkpointing, DescentResult, Domain, PointObjective, adam, adam_from,
+    AdamOptions, AdamState, Checkpointing, DescentResult, Domain, PointObjective, Stop, adam,
+    adam_from,
 };
 pub use descent::{DescentOptions, PointOptimizer};
 pub use target::Target;
