@@ -337,17 +337,24 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
         },
     );
 
-    // Growth with N and K: 512² box, fast only. Best of ten: on a shared
-    // machine the best of three still varied by a third from run to run.
+    // Growth with N and K: 512² box, then the same 65,536 points in 3D
+    // (64³, FINUFFT's nufft3d1/3d2 compare) and 4D (16⁴, no FINUFFT
+    // counterpart), fast only. Best of ten: on a shared machine the best of
+    // three still varied by a third from run to run.
     const REPEATS: usize = 10;
-    let sizes: &[usize] = if a.quick {
-        &[65_536]
+    let cases: &[(usize, usize, usize)] = if a.quick {
+        &[(2, 65_536, 512), (3, 65_536, 64), (4, 65_536, 16)]
     } else {
-        &[65_536, 1_048_576]
+        &[
+            (2, 65_536, 512),
+            (2, 1_048_576, 512),
+            (3, 65_536, 64),
+            (4, 65_536, 16),
+        ]
     };
-    for &n in sizes {
-        let points = registry::build("random", n, Some(2), &[])?.sample(&mut set_rng(3, 0))?;
-        let freqs = FrequencyBox::from_resolution(2, 512);
+    for &(dim, n, res) in cases {
+        let points = registry::build("random", n, Some(dim), &[])?.sample(&mut set_rng(3, 0))?;
+        let freqs = FrequencyBox::from_resolution(dim, res);
         // Errors against the ε = 1e-12 transform (the direct sums would take
         // minutes here): type 1's spectrum, then type 2 of that spectrum.
         let reference = NufftPlan::new(freqs, 1e-12)?;
@@ -377,7 +384,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
             });
             // The ε = 1e-12 rows are the reference itself: no error.
             let row = |kind: &str, seconds: f64, error: f64| Row {
-                case: format!("random N={n}, 512^2 box"),
+                case: format!("random N={n}, {res}^{dim} box"),
                 method: format!("fast {kind}tol={tol:e} sigma={sigma}"),
                 seconds,
                 max_power_error: None,
