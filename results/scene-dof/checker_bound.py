@@ -69,6 +69,26 @@ for n in (4, 8, 16):
     print(f"{N:4d} spp: unsheared {vu:.3e}, sheared {vs:.3e}, ratio {vu / vs:.2f}")
 
 
+# One edge in the footprint (no corner): the pixel sees a step in t_x only.
+def step(tx, ty, ox, oy):
+    return ((tx + ox) % (2 * HALF) < HALF).astype(float)
+
+
+def edge_unsheared(ox, oy):
+    x, y = multi_jitter(4, rng)
+    u, v = multi_jitter(4, rng)
+    return step(x + KAPPA * u[rng.permutation(16)], y, ox, oy).mean()
+
+
+def edge_sheared(ox, oy):
+    u, v = multi_jitter(4, rng)
+    return step(inverse_cdf(u, KAPPA), v, ox, oy).mean()
+
+
+vu, vs = mean_variance(edge_unsheared, offsets), mean_variance(edge_sheared, offsets)
+print(f"  16 spp, one edge: unsheared {vu:.3e}, sheared {vs:.3e}, ratio {vu / vs:.2f}")
+
+
 def lens(pattern):
     def estimate(ox, oy):
         u, v = pattern()
