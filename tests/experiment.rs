@@ -851,3 +851,88 @@ fn optimized_blue_noise_is_below_jitter_on_the_rate_table() {
         }
     }
 }
+
+/// Shard files come back from disk: a merge refuses one whose cells are
+/// missing, repeated or another shard's, and one whose experiment is no
+/// longer valid, naming the shard and the cell, instead of writing tables
+/// from them (or panicking).
+#[test]
+fn a_merge_refuses_shards_whose_cells_do_not_match_their_items() {
+    let dir = temp_dir("experiment-tampered");
+    let file = dir.join("small.json");
+    std::fs::write(&file, SMALL.replace(", \"cmj\"", "")).unwrap();
+    let runs = dir.join("runs");
+    for shard in ["0/2", "1/2"] {
+        ok(&[
+            "experiment",
+            file.to_str().unwrap(),
+            "--shard",
+            shard,
+            "-o",
+            runs.to_str().unwrap(),
+        ]);
+    }
+    let read = |name: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(runs.join(name)).unwrap()).unwrap()
+    };
+    type Tamper = fn(&mut serde_json::Value);
+    let cases: [(&str, Tamper, &str); 4] = [
+        (
+            "missing",
+            |s| {
+                s["cells"].as_array_mut().unwrap().pop();
+            },
+            "shard 0/2: misses the cell of",
+        ),
+        (
+            "repeated",
+            |s| {
+                let first = s["cells"][0].clone();
+                s["cells"].as_array_mut().unwrap().push(first);
+            },
+            "shard 0/2: holds the cell of `random` at n = 16 on `disk:r=0.3",
+        ),
+        (
+            "foreign",
+            |s| s["cells"][0]["n_index"] = serde_json::json!(1),
+            "which is not one of its items",
+        ),
+        (
+            "relabelled",
+            |s| s["cells"][0]["sampler"] = serde_json::json!("sobol"),
+            "is labelled `sobol`",
+        ),
+    ];
+    for (name, tamper, phrase) in cases {
+        let folder = dir.join(name);
+        std::fs::create_dir_all(&folder).unwrap();
+        let mut first = read("shard-0-of-2.json");
+        tamper(&mut first);
+        std::fs::write(folder.join("shard-0-of-2.json"), first.to_string()).unwrap();
+        std::fs::copy(
+            runs.join("shard-1-of-2.json"),
+            folder.join("shard-1-of-2.json"),
+        )
+        .unwrap();
+        assert_fails(&["merge", folder.to_str().unwrap()], phrase);
+        assert!(
+            !folder.join("variances.csv").exists(),
+            "{name}: tables written"
+        );
+    }
+    // Both shards carrying the same invalid experiment: refused, not a panic.
+    let folder = dir.join("invalid");
+    std::fs::create_dir_all(&folder).unwrap();
+    for name in ["shard-0-of-2.json", "shard-1-of-2.json"] {
+        let mut shard = read(name);
+        shard["experiment"]["integrands"][0] = serde_json::json!("nosuch");
+        std::fs::write(folder.join(name), shard.to_string()).unwrap();
+    }
+    assert_fails(
+        &["merge", folder.to_str().unwrap()],
+        "unknown integrand `nosuch`",
+    );
+    // The untouched shards still merge.
+    ok(&["merge", runs.to_str().unwrap()]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

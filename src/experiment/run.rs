@@ -272,11 +272,15 @@ fn check_memory(e: &Experiment, file: &str, items: usize) -> Result<(), Experime
 }
 
 /// The cells of a complete set of shards of one experiment, in the single
-/// run's order.
+/// run's order. Shard files are read back from disk, so the experiment they
+/// carry is validated again, and each shard must hold exactly the cells its
+/// items give (every integrand of every item it owns, once, labelled as the
+/// experiment says).
 ///
 /// # Errors
 /// [`ExperimentError::Invalid`] when the shards disagree on the experiment,
-/// miss or repeat a shard.
+/// miss or repeat a shard, carry an invalid experiment, or hold a cell that
+/// is missing, repeated, foreign to the shard or mislabelled.
 pub fn merge_shards(
     shards: &[ShardFile],
 ) -> Result<(Experiment, String, Vec<Cell>), ExperimentError> {
@@ -295,6 +299,23 @@ pub fn merge_shards(
         "experiment",
     )
     .map_err(invalid)?;
+    let e = &first.experiment;
+    let text = serde_json::to_string(e).map_err(|err| invalid(err.to_string()))?;
+    Experiment::parse(&text, &first.file)?;
+    let canonical: Vec<String> = e
+        .integrands
+        .iter()
+        .map(|spec| integrands::parse(spec).map(|f| f.spec()))
+        .collect::<Result<_, _>>()
+        .map_err(|err| invalid(err.to_string()))?;
+    for s in shards {
+        check_shard_cells(e, &canonical, s).map_err(|reason| {
+            invalid(format!(
+                "shard {}/{}: {reason}",
+                s.shard.index, s.shard.count
+            ))
+        })?;
+    }
     let mut cells: Vec<Cell> = shards
         .iter()
         .flat_map(|s| s.cells.iter().cloned())
@@ -311,4 +332,52 @@ pub fn merge_shards(
     };
     cells.sort_by_key(order);
     Ok((first.experiment.clone(), first.file.clone(), cells))
+}
+
+/// Checks that shard `s` of experiment `e` holds each cell its items give
+/// exactly once and nothing else; `canonical` are the integrands' specs as
+/// cells name them.
+fn check_shard_cells(e: &Experiment, canonical: &[String], s: &ShardFile) -> Result<(), String> {
+    let describe = |(si, ni, fi): (usize, usize, usize)| match (
+        e.samplers.get(si),
+        e.n.get(ni),
+        canonical.get(fi),
+    ) {
+        (Some(sampler), Some(n), Some(f)) => format!("`{sampler}` at n = {n} on `{f}`"),
+        _ => format!("sampler {si}, n index {ni}, integrand {fi} (out of range)"),
+    };
+    let owned: std::collections::BTreeSet<(usize, usize, usize)> = e
+        .items()
+        .into_iter()
+        .enumerate()
+        .filter(|&(item, _)| s.shard.owns(item))
+        .flat_map(|(_, (si, ni))| (0..canonical.len()).map(move |fi| (si, ni, fi)))
+        .collect();
+    let mut expected = owned.clone();
+    for c in &s.cells {
+        let key = (c.sampler_index, c.n_index, c.integrand_index);
+        if !owned.contains(&key) {
+            return Err(format!(
+                "holds the cell of {}, which is not one of its items",
+                describe(key)
+            ));
+        }
+        if !expected.remove(&key) {
+            return Err(format!("holds the cell of {} twice", describe(key)));
+        }
+        let (si, ni, fi) = key;
+        if c.sampler != e.samplers[si] || c.requested != e.n[ni] || c.integrand != canonical[fi] {
+            return Err(format!(
+                "the cell of {} is labelled `{}` at n = {} on `{}`",
+                describe(key),
+                c.sampler,
+                c.requested,
+                c.integrand
+            ));
+        }
+    }
+    match expected.into_iter().next() {
+        Some(key) => Err(format!("misses the cell of {}", describe(key))),
+        None => Ok(()),
+    }
 }
