@@ -369,6 +369,32 @@ fn a_sharded_table_run_merges_to_the_single_runs_bytes() {
         std::fs::read(parts.join("t.h")).unwrap(),
         "the merged table differs from the single run's"
     );
+    // A shard file tampered with: a set held twice, a set cut short.
+    let shard0 = parts.join("t.h.shard-0-of-3.json");
+    let original = std::fs::read_to_string(&shard0).unwrap();
+    type Tamper = fn(&mut serde_json::Value);
+    let tampered: [(&str, Tamper); 2] = [
+        ("holds set 0 twice", |v| {
+            let first = v["sets"][0].clone();
+            v["sets"].as_array_mut().unwrap().push(first);
+        }),
+        ("every set to have the same N (found 63 and 64)", |v| {
+            let coords = v["sets"][0][1].as_array_mut().unwrap();
+            coords.truncate(coords.len() - 2);
+        }),
+    ];
+    for (phrase, tamper) in tampered {
+        let mut v: serde_json::Value = serde_json::from_str(&original).unwrap();
+        tamper(&mut v);
+        std::fs::write(&shard0, v.to_string()).unwrap();
+        let out = varspec(&merge);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(phrase),
+            "{phrase}: {err}"
+        );
+    }
+    std::fs::write(&shard0, original).unwrap();
     std::fs::remove_file(parts.join("t.h.shard-1-of-3.json")).unwrap();
     let out = varspec(&merge);
     assert!(String::from_utf8_lossy(&out.stderr).contains("shard 1/3 is missing"));

@@ -94,6 +94,12 @@ pub fn merge_table_shards(shards: &[TableShard]) -> Result<(TableRun, Vec<PointS
                 .ok_or_else(|| {
                     format!("shard {}/{count} holds set {r}, not its own", s.shard.index)
                 })?;
+            if slot.is_some() {
+                return Err(format!(
+                    "shard {}/{count} holds set {r} twice",
+                    s.shard.index
+                ));
+            }
             *slot = Some(
                 PointSet::new(first.dim, coords.clone())
                     .map_err(|e| format!("set {r} of shard {}/{count}: {e}", s.shard.index))?,
