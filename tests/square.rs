@@ -333,6 +333,8 @@ fn command_line_designs_scores_and_labels_the_square() {
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["domain"], "square");
+    // 60 iterations hold fewer than the 51 scores the stopping rule needs.
+    assert_eq!(r["stopped"], serde_json::json!(["cap", "cap"]));
     let ours = r["comparison"]["optimized"]["halfplanes"]["mse"]
         .as_f64()
         .unwrap();

@@ -445,12 +445,13 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     varspec::io::write_point_file(&a.output, &design.points)?;
     println!(
-        "{} set(s) of {} 4D points optimized for {} projection term(s) in {:.2} s (from {})",
+        "{} set(s) of {} 4D points optimized for {} projection term(s) in {:.2} s (from {}; set 0: {})",
         a.sets,
         a.n,
         design.terms.len(),
         design.run.seconds,
-        design.run.init
+        design.run.init,
+        design.stopped[0].describe()
     );
     for t in &design.terms {
         println!(
@@ -497,9 +498,16 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     varspec::io::write_point_file(&a.output, &design.points)?;
     println!(
-        "{} set(s) of {} points designed on the square for {} in {:.2} s (from {}); \
+        "{} set(s) of {} points designed on the square for {} in {:.2} s (from {}; set 0: {}); \
          unshifted estimator, scored on {} members per family (seed {})",
-        a.sets, a.n, a.target, design.run.seconds, design.run.init, a.members, a.score_seed
+        a.sets,
+        a.n,
+        a.target,
+        design.run.seconds,
+        design.run.init,
+        design.stopped[0].describe(),
+        a.members,
+        a.score_seed
     );
     for (name, v) in &design.comparison {
         print!("  {name:<14}");

@@ -10,7 +10,7 @@ use serde::Serialize;
 use super::DesignRun;
 use crate::neighbours::closest_pair_ratio;
 use crate::optimize::projections::{ProjectionObjective, parse_projections};
-use crate::optimize::{AdamOptions, Domain, OptimizeError, adam};
+use crate::optimize::{AdamOptions, Domain, OptimizeError, Stop, adam};
 use crate::points::PointSet;
 use crate::registry;
 use crate::rng::set_rng;
@@ -70,6 +70,8 @@ pub struct ProjectionDesign {
     pub run: DesignRun,
     /// The iteration cap.
     pub iterations: usize,
+    /// Why each set's descent stopped (converged, accuracy floor or cap).
+    pub stopped: Vec<Stop>,
     /// Per term, before and after.
     pub terms: Vec<TermLoss>,
     /// XY and UV closest pairs of the designs.
@@ -154,6 +156,7 @@ pub fn design_projections(
             seconds,
         },
         iterations: options.iters,
+        stopped: results.iter().map(|x| x.1.stop).collect(),
         terms: terms_out,
         closest_pair_over_hexagonal: closest_pairs,
         loss: "sum of w_t L_t(M_t X) / L_t(M_t X0) over the projection terms",

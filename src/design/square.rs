@@ -11,6 +11,7 @@ use serde_json::{Map, Value, json};
 use super::DesignRun;
 use crate::baseline::classic_baselines;
 use crate::neighbours::closest_pair_ratio;
+use crate::optimize::Stop;
 use crate::points::PointSet;
 use crate::registry;
 use crate::rng::set_rng;
@@ -69,6 +70,8 @@ pub struct SquareDesign {
     pub estimator: &'static str,
     /// The iteration cap.
     pub iterations: usize,
+    /// Why each set's descent stopped (converged, accuracy floor or cap).
+    pub stopped: Vec<Stop>,
     /// What the loss is.
     pub loss: &'static str,
     /// Per set: the loss's score at the start.
@@ -180,6 +183,7 @@ pub fn design_on_square(
         },
         estimator: "unshifted: mean of f over the set on [0,1)^2",
         iterations: options.iters,
+        stopped: results.iter().map(|x| x.stop).collect(),
         loss: "sum of w_t MSE_t / MSE_t(start) (blue: repulsion / its value for uniform points); stochastic per iteration",
         score_start: results.iter().map(|x| x.start_score).collect(),
         score_best: results.iter().map(|x| x.best_score).collect(),
