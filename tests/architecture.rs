@@ -98,3 +98,43 @@ fn samplers_and_the_optimizer_do_not_name_the_registry() {
         );
     }
 }
+
+/// With `autotests = false` a test file runs only if tests/suite.rs declares
+/// it (or Cargo.toml names it as its own binary): a file added without
+/// either would compile nowhere and never run, silently.
+#[test]
+fn every_test_file_is_part_of_a_test_binary() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let suite = std::fs::read_to_string(root.join("tests/suite.rs")).unwrap();
+    let manifest = std::fs::read_to_string(root.join("Cargo.toml")).unwrap();
+    let declared: BTreeSet<String> = suite
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("mod "))
+        .map(|m| m.trim_end_matches(';').trim().to_string())
+        .collect();
+    let mut orphans = Vec::new();
+    for entry in std::fs::read_dir(root.join("tests")).unwrap() {
+        let path = entry.unwrap().path();
+        let Some(stem) = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|_| path.extension().is_some_and(|e| e == "rs"))
+        else {
+            continue;
+        };
+        let own_binary = manifest.contains(&format!("path = \"tests/{stem}.rs\""));
+        if stem != "suite" && !own_binary && !declared.contains(&stem) {
+            orphans.push(stem);
+        }
+    }
+    assert!(
+        orphans.is_empty(),
+        "tests/{{{}}}.rs: declare each in tests/suite.rs (mod NAME;) or as a [[test]] in Cargo.toml",
+        orphans.join(",")
+    );
+    assert!(
+        declared.len() > 30,
+        "tests/suite.rs declares {} modules",
+        declared.len()
+    );
+}
