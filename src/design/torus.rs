@@ -13,10 +13,9 @@ use serde_json::json;
 use super::DesignRun;
 use crate::baseline::{Baseline, classic_baselines};
 use crate::integrands::Integrand;
-use crate::optimize::adam::Stop;
 use crate::optimize::adapted::{CheckpointPlan, Kept, design_sets};
 use crate::optimize::lattice::{LatticeDesign, best_lattice};
-use crate::optimize::{DescentOptions, OptimizeError, PointOptimizer, Target};
+use crate::optimize::{DescentOptions, OptimizeError, PointOptimizer, Stop, Target};
 use crate::points::PointSet;
 use crate::registry;
 use crate::samplers::{Sampler, SamplerError};
@@ -187,7 +186,7 @@ impl TorusPlan {
             options.half = (res - 1) / 2;
         }
         match r.coarse {
-            Some(true) if r.dim != 2 || matches!(target, Target::Integrand(_)) => {
+            Some(true) if !DescentOptions::takes_coarse(r.dim, &target) => {
                 return Err(OptimizeError::Option(
                     "--coarse applies to 2D blue-noise targets (family:, power:, radial:), not to integrand targets or other dimensions".into(),
                 ));

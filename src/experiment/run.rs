@@ -300,8 +300,7 @@ pub fn merge_shards(
     )
     .map_err(invalid)?;
     let e = &first.experiment;
-    let text = serde_json::to_string(e).map_err(|err| invalid(err.to_string()))?;
-    Experiment::parse(&text, &first.file)?;
+    e.validate(&first.file)?;
     let canonical: Vec<String> = e
         .integrands
         .iter()

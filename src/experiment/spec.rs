@@ -111,12 +111,26 @@ impl Experiment {
     /// # Errors
     /// [`ExperimentError::Invalid`] naming the file and the rule broken.
     pub fn parse(text: &str, file: &str) -> Result<Self, ExperimentError> {
+        let e: Experiment = serde_json::from_str(text).map_err(|err| ExperimentError::Invalid {
+            file: file.to_string(),
+            reason: format!("not a valid experiment: {err}"),
+        })?;
+        e.validate(file)?;
+        Ok(e)
+    }
+
+    /// Checks the rules [`Experiment::parse`] enforces, for an experiment
+    /// read some other way (e.g. inside a shard file); `file` names it in
+    /// the error.
+    ///
+    /// # Errors
+    /// [`ExperimentError::Invalid`] naming the file and the rule broken.
+    pub fn validate(&self, file: &str) -> Result<(), ExperimentError> {
+        let e = self;
         let invalid = |reason: String| ExperimentError::Invalid {
             file: file.to_string(),
             reason,
         };
-        let e: Experiment = serde_json::from_str(text)
-            .map_err(|err| invalid(format!("not a valid experiment: {err}")))?;
         plain_name(&e.name).map_err(invalid)?;
         if let Some(kind) = e.kind.as_deref().filter(|k| *k != "variance") {
             return Err(invalid(format!(
@@ -186,7 +200,7 @@ impl Experiment {
                 used.push((requested, n));
             }
         }
-        Ok(e)
+        Ok(())
     }
 
     /// The dimension of its integrands.

@@ -113,10 +113,16 @@ impl DescentOptions {
             },
             step: 0.05,
             final_step: 0.002,
-            coarse_half: (dim == 2 && !matches!(target, Target::Integrand(_)) && n >= COARSE_FROM)
-                .then_some(half / 4),
+            coarse_half: (Self::takes_coarse(dim, target) && n >= COARSE_FROM).then_some(half / 4),
             upsampling: Upsampling::Auto { points: n },
         }
+    }
+
+    /// Whether a descent toward `target` in `dim` dimensions can run the
+    /// coarse phase ([`DescentOptions::coarse_half`]): 2D blue-noise
+    /// targets (`family:`, `power:`, `radial:`).
+    pub fn takes_coarse(dim: usize, target: &Target) -> bool {
+        dim == 2 && !matches!(target, Target::Integrand(_))
     }
 }
 
