@@ -91,17 +91,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .zip(&powers)
             .zip(&variances)
             .map(|((f, pf), v)| {
-                let mut inside = 0.0;
                 let mut energy = 0.0;
-                for (i, (&p, &w)) in spectrum.power.iter().zip(pf).enumerate() {
+                for (i, &w) in pf.iter().enumerate() {
                     let mut k = [0i64; 2];
                     freqs.frequency(i, &mut k);
                     if i != zero && k[0].abs() <= box_half && k[1].abs() <= box_half {
-                        inside += p * w;
                         energy += w;
                     }
                 }
-                let _ = inside;
                 ((f.variance() - energy).max(0.0) / n_used as f64) / v
             })
             .sum::<f64>()
