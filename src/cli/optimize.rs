@@ -654,7 +654,8 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
     let out = json!({
         "sampler": a.sampler, "integrand": f.spec(), "n": a.n, "sets": a.sets, "seed": a.seed,
         "estimator": "unshifted: mean of f over the transformed set (the render's); unbiased for every candidate",
-        "pixel": {"kind": analysis.kind.name(), "depth": analysis.depth, "kappa": analysis.kappa, "kappas": analysis.kappas},
+        "pixel": {"kind": analysis.kind.name(), "depth": analysis.depth, "kappa": analysis.kappa, "kappas": analysis.kappas,
+                  "footprint_kappa_range": found.slopes.range, "footprint_slope_spread": found.slopes.spread},
         "candidates": found.candidates.iter().map(row).collect::<Vec<_>>(),
         "chosen": row(best), "double_wedge": found.double_wedge, "hairline": found.hairline,
         "sensitivity": found.sensitivity.as_ref().map(|s| json!({"step": varspec::optimize::shear::SENSITIVITY_STEP, "minus": row(&s[0]), "plus": row(&s[1])})),
@@ -665,11 +666,13 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     println!(
-        "{} ({} pixel, depth {:.4}, κ {:.4}{}{}) with {} N={}, {} realizations per candidate:",
+        "{} ({} pixel, depth {:.4}, κ {:.4} ({:.4} to {:.4} over the footprint){}{}) with {} N={}, {} realizations per candidate:",
         f.spec(),
         analysis.kind.name(),
         analysis.depth,
         analysis.kappa,
+        found.slopes.range[0],
+        found.slopes.range[1],
         if found.double_wedge {
             "; double wedge"
         } else {

@@ -363,9 +363,10 @@ pub(super) fn scene_pixels(
     let planes: Vec<String> = PIXEL_PLANES.iter().map(|p| p.to_string()).collect();
     let mut rows: Vec<Vec<String>> = Vec::new();
     let mut table = format!(
-        "| pixel | kind | κ of the probed depths | no shear | chosen | variance | lower by | \
-         variance with the slope −{SENSITIVITY_STEP} / +{SENSITIVITY_STEP} | realizations |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
+        "| pixel | kind | κ of the probed depths | κ over the footprint | no shear | chosen | \
+         variance | lower by | variance with the slope −{SENSITIVITY_STEP} / +{SENSITIVITY_STEP} \
+         | realizations |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for &[px, py] in pixels {
         let f = PixelIntegrand::new(Arc::clone(&scene), px, py);
@@ -434,6 +435,15 @@ pub(super) fn scene_pixels(
             0.0 => "—".to_string(),
             v => format!("{:.2}×", none.estimate.variance / v),
         };
+        // Probed on single-depth pixels only.
+        let footprint = if a.kind == crate::scene::analysis::PixelKind::Single {
+            format!(
+                "{:.3} to {:.3}",
+                found.slopes.range[0], found.slopes.range[1]
+            )
+        } else {
+            "—".to_string()
+        };
         let sensitivity = found.sensitivity.as_ref().map_or("—".to_string(), |s| {
             format!(
                 "{:.3}× / {:.3}×",
@@ -442,7 +452,7 @@ pub(super) fn scene_pixels(
             )
         });
         table += &format!(
-            "| ({px}, {py}) | {kind} | {} | {} | {} {:.3} | {} | {lower} | {sensitivity} | {} |\n",
+            "| ({px}, {py}) | {kind} | {} | {footprint} | {} | {} {:.3} | {} | {lower} | {sensitivity} | {} |\n",
             kappas_shown.join(", "),
             cell(none),
             best.shear.form(),
@@ -464,6 +474,8 @@ pub(super) fn scene_pixels(
             format!("{:e}", a.depth),
             format!("{:e}", a.kappa),
             kappas.join(";"),
+            format!("{:e}", found.slopes.range[0]),
+            format!("{:e}", found.slopes.range[1]),
             best.shear.form().into(),
             format!("{a0:e}"),
             format!("{a1:e}"),
@@ -492,6 +504,8 @@ pub(super) fn scene_pixels(
             "depth",
             "kappa",
             "kappas",
+            "kappa_footprint_min",
+            "kappa_footprint_max",
             "chosen_form",
             "chosen_a",
             "chosen_b",
@@ -512,7 +526,9 @@ pub(super) fn scene_pixels(
         "- `{prefix}.csv`, `{prefix}-X-Y-{{f,before,after}}-{{xu,yv}}.png`: pixels of `{}` as \
          integrands with {sampler} at N = {n}: the light field's power (`f`, a {res}² grid), the \
          transformation the measured search chooses among no shear and, per probed depth, the \
-         position shear −κ and the footprint warp κ (the render's unshifted estimator, common \
+         position shear −κ and the footprint warp κ, and where κ changes across the footprint by \
+         a tenth of a stratum of t or more, warps across that range (the render's unshifted \
+         estimator, common \
          realizations, 2% relative standard error on the choice), and the spectra of {sets} sets \
          before and after it. A pixel is a double wedge when its probes meet two depths, a \
          hairline when moving the warp's slope by ±{SENSITIVITY_STEP} raises the variance by \

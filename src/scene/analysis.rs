@@ -47,6 +47,19 @@ pub const DEPTH_TOLERANCE: f64 = 0.05;
 /// Probe positions along each lens axis (3 × 3 rays per pixel).
 const PROBES: [f64; 3] = [0.1, 0.5, 0.9];
 
+/// Positions along each axis of the footprint probes: 2 × 2 points of the
+/// pixel, each through 4 × 4 points of the lens.
+const FOOTPRINT_PIXEL: [f64; 2] = [0.1, 0.9];
+const FOOTPRINT_LENS: [f64; 4] = [0.1, 0.37, 0.63, 0.9];
+
+/// The pixel search compares warps across the footprint's range of κ when
+/// that range moves the warp's argument t = x + κu by at least this
+/// fraction of one of its strata (width (1 + |κ|)/√N for N samples).
+pub const SLOPE_SPREAD_STRATA: f64 = 0.1;
+
+/// Warp slopes the pixel search measures across the footprint's range.
+pub const SLOPE_CANDIDATES: usize = 9;
+
 /// The local analysis of one pixel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PixelAnalysis {
@@ -192,6 +205,70 @@ pub fn footprint_warp(kappa: f64, xi1: f64, xi2: f64) -> (f64, f64) {
     // κ < 0: t − k = x − k·u with u = 1 − w.
     let u = if kappa > 0.0 { w } else { clamp(1.0 - w) };
     (x, u)
+}
+
+/// How the light field's slope changes across a single-depth pixel's
+/// footprint: what a slanted or curved surface adds to the first-order
+/// model (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct FootprintSlopes {
+    /// The least and greatest κ of the centre ray's surface over 2 × 2
+    /// pixel points × 4 × 4 lens points (probes within [`DEPTH_TOLERANCE`]
+    /// of the centre depth), the centre's κ included.
+    pub range: [f64; 2],
+    /// That range in strata of the warp's argument t = x + κu at the
+    /// sampler's N: (κ_max − κ_min)·√N/(1 + |κ|).
+    pub spread: f64,
+}
+
+impl FootprintSlopes {
+    /// Probes the footprint of pixel (px, py), analysed as `a`, for `n`
+    /// samples per pixel; [κ, κ] and spread 0 unless the pixel sees one
+    /// depth through a lens.
+    pub fn probe(scene: &Scene, px: usize, py: usize, a: &PixelAnalysis, n: usize) -> Self {
+        let camera = scene.camera();
+        let mut range = [a.kappa, a.kappa];
+        let lens = scene.integrand() == IntegrandKind::Lens && scene.has_aperture();
+        if lens && a.kind == PixelKind::Single {
+            let d0 = a.depth;
+            for x in FOOTPRINT_PIXEL {
+                for y in FOOTPRINT_PIXEL {
+                    for u in FOOTPRINT_LENS {
+                        for v in FOOTPRINT_LENS {
+                            let ray = camera.ray(px, py, [x, y, u, v]);
+                            let hit = scene.geometry().closest(ray.origin, ray.direction, 0.0);
+                            if let Some(d) = hit.map(|h| camera.depth(h.point)) {
+                                if (d - d0).abs() <= DEPTH_TOLERANCE * d0 {
+                                    let k = camera.shear_at_depth(d);
+                                    range = [range[0].min(k), range[1].max(k)];
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        FootprintSlopes {
+            range,
+            spread: (range[1] - range[0]) * (n as f64).sqrt() / (1.0 + a.kappa.abs()),
+        }
+    }
+
+    /// The warp slopes worth measuring besides the centre's:
+    /// [`SLOPE_CANDIDATES`] evenly over the range when its spread reaches
+    /// [`SLOPE_SPREAD_STRATA`] (the pixel's best slope may then differ from
+    /// the centre's by what the sampler resolves), otherwise none.
+    pub fn candidates(&self) -> Vec<f64> {
+        if self.spread < SLOPE_SPREAD_STRATA {
+            return Vec::new();
+        }
+        let [lo, hi] = self.range;
+        let last = (SLOPE_CANDIDATES - 1) as f64;
+        (0..SLOPE_CANDIDATES)
+            .map(|i| lo + (hi - lo) * i as f64 / last)
+            .filter(|&k| k != 0.0)
+            .collect()
+    }
 }
 
 /// Probes pixel (px, py) with 3 × 3 rays through its centre from points
