@@ -60,6 +60,13 @@ pub const SLOPE_SPREAD_STRATA: f64 = 0.1;
 /// Warp slopes the pixel search measures across the footprint's range.
 pub const SLOPE_CANDIDATES: usize = 9;
 
+/// Slopes below this (pixels per unit of u) follow no shear: the light
+/// field moves by less across the whole lens, and the warp's lens
+/// coordinate u = (t − x)/κ would carry the rounding of t (≈ ε) magnified
+/// by 1/κ (2e-7 here, 0.02 at κ = 1e-14), so the points would no longer be
+/// uniform.
+pub const MIN_WARP_SLOPE: f64 = 1e-9;
+
 /// The local analysis of one pixel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PixelAnalysis {
@@ -120,10 +127,11 @@ impl SampleShear {
     pub const NONE: SampleShear = SampleShear::Position([0.0, 0.0]);
 
     /// The transformation that follows a light field of shear κ: the warp;
-    /// none for an unsheared field (κ = 0), where the warp's limit would
-    /// exchange the position and lens coordinates ([`footprint_warp`]).
+    /// none for an unsheared field (|κ| below [`MIN_WARP_SLOPE`]), where
+    /// the warp's limit would exchange the position and lens coordinates
+    /// and its lens coordinate loses its precision ([`footprint_warp`]).
     pub fn following(kappa: f64) -> SampleShear {
-        if kappa == 0.0 {
+        if kappa.abs() < MIN_WARP_SLOPE {
             SampleShear::NONE
         } else {
             SampleShear::Warp(kappa)
@@ -257,7 +265,9 @@ impl FootprintSlopes {
     /// The warp slopes worth measuring besides the centre's:
     /// [`SLOPE_CANDIDATES`] evenly over the range when its spread reaches
     /// [`SLOPE_SPREAD_STRATA`] (the pixel's best slope may then differ from
-    /// the centre's by what the sampler resolves), otherwise none.
+    /// the centre's by what the sampler resolves), otherwise none; never
+    /// one below [`MIN_WARP_SLOPE`] (a range across the focal plane), which
+    /// no shear, always a candidate, stands for.
     pub fn candidates(&self) -> Vec<f64> {
         if self.spread < SLOPE_SPREAD_STRATA {
             return Vec::new();
@@ -266,7 +276,7 @@ impl FootprintSlopes {
         let last = (SLOPE_CANDIDATES - 1) as f64;
         (0..SLOPE_CANDIDATES)
             .map(|i| lo + (hi - lo) * i as f64 / last)
-            .filter(|&k| k != 0.0)
+            .filter(|k| k.abs() >= MIN_WARP_SLOPE)
             .collect()
     }
 }

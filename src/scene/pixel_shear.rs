@@ -20,7 +20,9 @@
 //! & Jarosz 2017). The choice never has a variance above the unsheared
 //! one: no shear is a candidate.
 
-use super::analysis::{FootprintSlopes, PixelAnalysis, PixelKind, SampleShear, analyse_pixel};
+use super::analysis::{
+    FootprintSlopes, MIN_WARP_SLOPE, PixelAnalysis, PixelKind, SampleShear, analyse_pixel,
+};
 use super::pixel::PixelIntegrand;
 use crate::optimize::shear::SENSITIVITY_STEP;
 use crate::rng::set_rng;
@@ -109,7 +111,7 @@ pub fn search_pixel_shear(
     let slopes = FootprintSlopes::probe(f.scene(), px, py, &analysis, sampler.points_per_set());
     let mut shears = vec![SampleShear::NONE];
     if analysis.kind != PixelKind::Background {
-        for &k in analysis.kappas.iter().filter(|k| **k != 0.0) {
+        for &k in analysis.kappas.iter().filter(|k| k.abs() >= MIN_WARP_SLOPE) {
             shears.push(SampleShear::Position([-k, -k]));
             shears.push(SampleShear::Warp(k));
         }

@@ -8,7 +8,7 @@
 use rayon::prelude::*;
 
 use super::Scene;
-use super::analysis::{PixelAnalysis, PixelKind, SampleShear, analyse_pixel};
+use super::analysis::{MIN_WARP_SLOPE, PixelAnalysis, PixelKind, SampleShear, analyse_pixel};
 use super::image::GreyImage;
 use crate::rng::set_rng;
 use crate::samplers::{Sampler, SamplerError};
@@ -123,7 +123,7 @@ pub fn pixel_shears(
                     let candidates = std::iter::once(SampleShear::NONE).chain(
                         a.kappas
                             .iter()
-                            .filter(|k| **k != 0.0)
+                            .filter(|k| k.abs() >= MIN_WARP_SLOPE)
                             .flat_map(|&k| [SampleShear::Position([-k, -k]), SampleShear::Warp(k)]),
                     );
                     for shear in candidates {
