@@ -35,9 +35,10 @@ pub(super) const MAX_RENDERS: usize = 4096;
 const REFERENCE_STREAM: u64 = 0x7e_fe7e;
 const SELECTION_STREAM: u64 = 0x5e_1ec7;
 /// The references' sampler: Owen-scrambled Sobol' by Burley's hash
-/// (JCGT 9(4), 2020), unbiased like the nested scramble and three times
-/// faster to draw at 4096 points a pixel, where drawing the nested scramble
-/// took longer than tracing the rays.
+/// (JCGT 9(4), 2020), unbiased like the nested scramble and faster to
+/// draw: a 1024-spp render of `dof` takes 6.6 s against 11.3 s with the
+/// nested scramble (25.7 s before the nested scramble drew only its top
+/// ⌈log₂ N⌉ levels), 2 cores.
 pub(super) const REFERENCE_SAMPLER: &str = "sobol:scramble=hash";
 /// Random points per cell of a pixel's light-field power
 /// ([`PixelIntegrand::plane_power`]).
