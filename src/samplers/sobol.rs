@@ -22,7 +22,7 @@
 //! bits whatever the digits they flip: the rest of the mantissa is uniform
 //! (53 − m bits from the set's stream). The same distribution as
 //! scrambling all 32 digits, at m node draws per coordinate instead of 32
-//! (7.9× fewer at N = 16). The hash scramble works on 32 digits; 21
+//! (8× fewer at N = 16). The hash scramble works on 32 digits; 21
 //! uniform bits complete its mantissa. Either way every coordinate is
 //! uniform on [0,1).
 
