@@ -1018,3 +1018,44 @@ fn bench_tables_are_csv_with_named_columns() {
     // A comma inside a field is quoted, not a column break.
     assert!(rows.iter().any(|r| r[1] == *"fourier K=64, no tail"));
 }
+
+/// `bench samplers --quick` times every listed sampler at each (N, d) it
+/// makes: 4D-only samplers (umj, padded) have no 2D rows, 2D-only ones
+/// (multijitter, cmj) no 4D rows, and every time is positive and finite.
+#[test]
+fn bench_samplers_lists_each_sampler_at_the_sizes_it_makes() {
+    let dir = temp_dir("bench-samplers");
+    let path = dir.join("samplers.csv");
+    let run = varspec(&[
+        "bench",
+        "samplers",
+        "--quick",
+        "--csv",
+        path.to_str().unwrap(),
+    ]);
+    assert!(run.status.success(), "{run:?}");
+    let (header, rows) = csv_table(&path);
+    assert_eq!(
+        header,
+        [
+            "sampler",
+            "n",
+            "dim",
+            "sets",
+            "seconds",
+            "ns_per_coordinate"
+        ]
+    );
+    let count = |name: &str, dim: &str| {
+        rows.iter()
+            .filter(|r| &r[0] == name && &r[2] == dim)
+            .count()
+    };
+    assert_eq!((count("sobol", "2"), count("sobol", "4")), (3, 3));
+    assert_eq!((count("umj", "2"), count("umj", "4")), (0, 3));
+    assert_eq!((count("cmj", "2"), count("cmj", "4")), (3, 0));
+    assert!(rows.iter().all(|r| {
+        let ns: f64 = r[5].parse().unwrap();
+        ns.is_finite() && ns > 0.0
+    }));
+}

@@ -26,6 +26,20 @@ pub enum BenchCommand {
     /// Ray tracing: camera (closest-hit) and shadow (any-hit) rays per
     /// second on a ~100k-triangle scene, CWBVH beside BVH2.
     Render(RenderArgs),
+    /// Samplers: nanoseconds per coordinate drawn, one thread, at N = 16,
+    /// 256 and 4096 in 2D and 4D.
+    Samplers(SamplersArgs),
+}
+
+#[derive(clap::Args)]
+pub struct SamplersArgs {
+    /// CSV of the table.
+    #[arg(long, default_value = "out/bench/bench-samplers.csv")]
+    csv: PathBuf,
+    /// One run of 2^16 coordinates per case instead of the best of 3 runs
+    /// of 2^20.
+    #[arg(long)]
+    quick: bool,
 }
 
 #[derive(clap::Args)]
@@ -73,13 +87,83 @@ pub fn run(c: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Spectrum(a) => &a.csv,
         BenchCommand::Predict(a) => &a.csv,
         BenchCommand::Render(a) => &a.csv,
+        BenchCommand::Samplers(a) => &a.csv,
     };
     prepare(csv)?;
     match c {
         BenchCommand::Spectrum(a) => spectrum(a),
         BenchCommand::Predict(a) => predict(a),
         BenchCommand::Render(a) => render(a),
+        BenchCommand::Samplers(a) => samplers(a),
     }
+}
+
+/// Samplers timed by `bench samplers`: every 2D and 4D family, both Sobol'
+/// scrambles.
+const TIMED_SAMPLERS: [&str; 10] = [
+    "random",
+    "jitter",
+    "multijitter",
+    "cmj",
+    "sobol",
+    "sobol:scramble=hash",
+    "halton",
+    "poisson-disk",
+    "umj",
+    "padded",
+];
+
+fn samplers(a: SamplersArgs) -> anyhow::Result<()> {
+    #[derive(serde::Serialize)]
+    struct Row {
+        sampler: String,
+        n: usize,
+        dim: usize,
+        sets: usize,
+        seconds: f64,
+        ns_per_coordinate: f64,
+    }
+    // One thread: the cost of a coordinate, not of the machine.
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let (repeats, log2) = if a.quick { (1, 16) } else { (3, 20) };
+    println!(
+        "nanoseconds per coordinate drawn (one thread, best of {repeats} run(s) of 2^{log2} coordinates)"
+    );
+    println!("{:<22} {:>6} {:>4} {:>12}", "sampler", "N", "d", "ns/coord");
+    let mut rows = Vec::new();
+    for name in TIMED_SAMPLERS {
+        for n in [16usize, 256, 4096] {
+            for dim in [2usize, 4] {
+                // Samplers that do not make this (N, d) are skipped.
+                let Ok((sampler, n)) = registry::build_nearest(name, n, Some(dim), &[]) else {
+                    continue;
+                };
+                let dim = sampler.dim();
+                let sets = ((1usize << log2) / (n * dim)).max(1);
+                let (seconds, drawn) = pool.install(|| {
+                    time(repeats, || {
+                        (0..sets as u64)
+                            .map(|r| sampler.sample(&mut set_rng(7, r)).map(|s| s.len()))
+                            .sum::<Result<usize, _>>()
+                    })
+                });
+                drawn?;
+                let ns = seconds * 1e9 / (sets * n * dim) as f64;
+                println!("{name:<22} {n:>6} {dim:>4} {ns:>12.1}");
+                rows.push(Row {
+                    sampler: name.to_string(),
+                    n,
+                    dim,
+                    sets,
+                    seconds,
+                    ns_per_coordinate: ns,
+                });
+            }
+        }
+    }
+    write_atomic(&a.csv, |w| write_csv_rows(w, rows.iter()))?;
+    println!("wrote {}", a.csv.display());
+    Ok(())
 }
 
 /// Five tessellated spheres behind one another and a floor, seen at
