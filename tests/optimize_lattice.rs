@@ -12,7 +12,7 @@ use varspec::optimize::{DescentOptions, DescentResult, PointOptimizer, Target};
 use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::samplers::Sampler;
-use varspec::variance::{VarianceError, spatial, spatial_variance};
+use varspec::variance::{SpatialEstimate, VarianceError, spatial, spatial_variance};
 
 /// The lattice rule's N-term form equals the generic all-pairs spatial
 /// form evaluated on a shifted copy of its points, and every lattice of N
@@ -94,27 +94,8 @@ fn adapted_design_beats_cmj_on_unseen_halfplanes() {
             "halfplane:angle=139.7,offset=-0.23",
             "halfplane:angle=33.3,offset=0.19",
         ] {
-            let f = integrands::parse(spec).unwrap();
-            let target = Target::parse(spec).unwrap();
-            let optimizer =
-                PointOptimizer::new(2, &target, DescentOptions::for_target(n, 2, &target)).unwrap();
-            let start = best_lattice(n, f.as_ref()).unwrap();
-            let kept = design_sets(
-                &optimizer,
-                &start.lattice,
-                Some(f.as_ref()),
-                9,
-                1,
-                &|_, _| {},
-                None,
-            )
-            .unwrap();
-            let ours = kept[0].variance().unwrap();
-            let cmj = registry::build("cmj", n, Some(2), &[]).unwrap();
-            let c = spatial(f.as_ref(), 64, |r| -> Result<_, VarianceError> {
-                Ok(cmj.sample(&mut set_rng(17, r as u64))?)
-            })
-            .unwrap();
+            let ours = default_design_variance(spec, n);
+            let c = cmj_variance(spec, n, 17);
             let ratio = ours / (c.variance - 3.0 * c.stderr);
             assert!(
                 ratio <= bound,
@@ -201,34 +182,15 @@ fn axis_aligned_halfplanes_have_a_floor_the_design_reaches() {
         ("halfplane:angle=0,offset=0.265", 0.235),
         ("halfplane:angle=90,offset=0.212", 0.288),
     ] {
-        let f = integrands::parse(spec).unwrap();
         let nf = n as f64;
         let frac = (nf * area).fract();
         let floor = frac * (1.0 - frac) / (nf * nf);
-        let target = Target::parse(spec).unwrap();
-        let optimizer =
-            PointOptimizer::new(2, &target, DescentOptions::for_target(n, 2, &target)).unwrap();
-        let start = best_lattice(n, f.as_ref()).unwrap();
-        let kept = design_sets(
-            &optimizer,
-            &start.lattice,
-            Some(f.as_ref()),
-            9,
-            1,
-            &|_, _| {},
-            None,
-        )
-        .unwrap();
-        let ours = kept[0].variance().unwrap();
+        let ours = default_design_variance(spec, n);
         assert!(
             (ours - floor).abs() <= 1e-9 * floor,
             "{spec}: design variance {ours:e}, the 1D floor f(1 − f)/N² = {floor:e}"
         );
-        let cmj = registry::build("cmj", n, Some(2), &[]).unwrap();
-        let c = spatial(f.as_ref(), 64, |r| -> Result<_, VarianceError> {
-            Ok(cmj.sample(&mut set_rng(23, r as u64))?)
-        })
-        .unwrap();
+        let c = cmj_variance(spec, n, 23);
         let expected = 1.0 / (3.0 * nf * nf);
         assert!(
             (c.variance - expected).abs() <= 3.0 * c.stderr,
@@ -237,4 +199,37 @@ fn axis_aligned_halfplanes_have_a_floor_the_design_reaches() {
             c.stderr
         );
     }
+}
+
+/// The default adapted design for the 2D integrand `spec` at N (the best
+/// lattice, the descent, kept by the exact form; seed 9): its exact
+/// variance.
+fn default_design_variance(spec: &str, n: usize) -> f64 {
+    let f = integrands::parse(spec).unwrap();
+    let target = Target::parse(spec).unwrap();
+    let optimizer =
+        PointOptimizer::new(2, &target, DescentOptions::for_target(n, 2, &target)).unwrap();
+    let start = best_lattice(n, f.as_ref()).unwrap();
+    let kept = design_sets(
+        &optimizer,
+        &start.lattice,
+        Some(f.as_ref()),
+        9,
+        1,
+        &|_, _| {},
+        None,
+    )
+    .unwrap();
+    kept[0].variance().unwrap()
+}
+
+/// CMJ's shift-randomized variance on `spec` at N by the spatial form,
+/// over 64 realizations of stream `seed`.
+fn cmj_variance(spec: &str, n: usize, seed: u64) -> SpatialEstimate {
+    let f = integrands::parse(spec).unwrap();
+    let cmj = registry::build("cmj", n, Some(2), &[]).unwrap();
+    spatial(f.as_ref(), 64, |r| -> Result<_, VarianceError> {
+        Ok(cmj.sample(&mut set_rng(seed, r as u64))?)
+    })
+    .unwrap()
 }
