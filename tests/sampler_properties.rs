@@ -380,16 +380,7 @@ fn halton_leading_zero_digits_are_uniform() {
         let mut x: Vec<f64> = (0..r)
             .map(|i| s.sample(&mut set_rng(0x4a17, i)).unwrap().point(0)[dim])
             .collect();
-        x.sort_by(f64::total_cmp);
-        let ks = x
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| {
-                (v - i as f64 / r as f64)
-                    .abs()
-                    .max((v - (i + 1) as f64 / r as f64).abs())
-            })
-            .fold(0.0, f64::max);
+        let ks = crate::common::ks_from_uniform(&mut x);
         assert!(
             ks < 1.63 / (r as f64).sqrt(),
             "dimension {dim}: KS distance {ks} of point 0 from U[0, 1)"

@@ -687,16 +687,7 @@ fn the_smallest_warp_keeps_the_lens_coordinate_uniform() {
                 footprint_warp(kappa, xi1, xi2).1
             })
             .collect();
-        u.sort_by(f64::total_cmp);
-        let ks = u
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| {
-                (v - i as f64 / n as f64)
-                    .abs()
-                    .max((v - (i + 1) as f64 / n as f64).abs())
-            })
-            .fold(0.0, f64::max);
+        let ks = crate::common::ks_from_uniform(&mut u);
         assert!(
             ks < 1.63 / (n as f64).sqrt(),
             "κ = {kappa:e}: KS distance {ks} of the warped u"

@@ -63,6 +63,18 @@ pub fn assert_fails(args: &[&str], phrase: &str) {
     );
     assert!(!err.contains("panicked"), "{args:?}: {err}");
 }
+/// The Kolmogorov–Smirnov distance of `values` from U[0, 1) (sorts them).
+/// Its 99% critical value for n values is about 1.63/√n.
+pub fn ks_from_uniform(values: &mut [f64]) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let n = values.len() as f64;
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (v - i as f64 / n).abs().max((v - (i + 1) as f64 / n).abs()))
+        .fold(0.0, f64::max)
+}
+
 pub mod direct;
 pub mod fuzz;
 pub mod hostile;
