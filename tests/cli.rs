@@ -132,7 +132,7 @@ fn bad_requests_fail_with_a_specific_message() {
                 "--range",
                 "1e300",
             ],
-            "--range a positive number up to 64 (got 1e300)",
+            "--range 1e300: the search's half-width must be a positive number up to 64",
         ),
         (
             vec![
@@ -145,7 +145,7 @@ fn bad_requests_fail_with_a_specific_message() {
                 "--range",
                 "inf",
             ],
-            "(got inf)",
+            "--range inf: the search's half-width",
         ),
         (
             vec![
@@ -172,6 +172,10 @@ fn bad_requests_fail_with_a_specific_message() {
                 "2",
             ],
             "--res 2: the Fourier box |k| < K/2 needs K >= 3",
+        ),
+        (
+            vec!["spectrum", "--sampler", "jitter", "-n", "64", "--res", "2"],
+            "--res 2: the box |k| < K/2 needs K >= 3",
         ),
         (
             vec![
@@ -917,10 +921,12 @@ fn a_radial_table_of_huge_weights_is_optimized_not_returned_as_its_start() {
 #[test]
 fn a_closed_standard_output_is_not_an_error() {
     // `varspec … | head -1`: the reader leaves after the first line. print!
-    // panicked with "failed printing to stdout: Broken pipe" and a backtrace.
+    // panicked with "failed printing to stdout: Broken pipe" and a
+    // backtrace; CSV written through the csv crate (sample, pcf) lost the
+    // error's kind and exited 1 with "Broken pipe".
     use std::process::{Command, Stdio};
-    let mut child = Command::new(env!("CARGO_BIN_EXE_varspec"))
-        .args([
+    for args in [
+        &[
             "converge",
             "--sampler",
             "jitter",
@@ -928,16 +934,22 @@ fn a_closed_standard_output_is_not_an_error() {
             "16,64,256,1024",
             "--integrand",
             "disk:r=0.3",
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{:?}: {err}", out.status);
-    assert!(!err.contains("panicked"), "{err}");
+        ][..],
+        &["sample", "random", "-n", "100000", "--sets", "4"],
+        &["pcf", "--sampler", "jitter", "-n", "64", "--bins", "100000"],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_varspec"))
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {:?}: {err}", out.status);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
 }
 
 /// A CSV file's header and records, read by the csv crate.

@@ -102,8 +102,11 @@ fn integrand_power(
 const PIXEL_RAYS_PER_CELL: usize = 16;
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    if a.res < 2 {
-        bail!("--res {}: the box |k| < K/2 needs K >= 2", a.res);
+    if a.res < 3 {
+        bail!(
+            "--res {}: the box |k| < K/2 needs K >= 3 to hold a frequency besides k = 0",
+            a.res
+        );
     }
     super::args::check_outputs([
         a.csv.as_deref(),

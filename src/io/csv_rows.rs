@@ -17,9 +17,19 @@ pub fn write_csv_rows<R: Serialize>(
 ) -> io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
     for row in rows {
-        w.serialize(row).map_err(io::Error::other)?;
+        w.serialize(row).map_err(csv_io_error)?;
     }
     w.flush()
+}
+
+/// The I/O error under a `csv` error, its kind kept (a closed pipe stays
+/// `BrokenPipe`, which the command line treats as success), or the error
+/// as `Other` when it is not one of I/O.
+pub fn csv_io_error(e: csv::Error) -> io::Error {
+    match e.into_kind() {
+        csv::ErrorKind::Io(cause) => cause,
+        other => io::Error::other(format!("{other:?}")),
+    }
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ use std::fs::File;
 use std::io::{self, BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 
+use super::csv_rows::csv_io_error;
 use super::npy;
 use crate::points::PointSet;
 
@@ -515,7 +516,7 @@ pub fn write_point_sets(
         if numbered {
             header.insert(0, "set".into());
         }
-        csv.write_record(&header)?;
+        csv.write_record(&header).map_err(csv_io_error)?;
         let mut row = Vec::with_capacity(dim + 1);
         for (s, set) in sets.iter().enumerate() {
             for p in set.points() {
@@ -524,7 +525,7 @@ pub fn write_point_sets(
                     row.push(s.to_string());
                 }
                 row.extend(p.iter().map(|v| format!("{v:?}")));
-                csv.write_record(&row)?;
+                csv.write_record(&row).map_err(csv_io_error)?;
             }
         }
         return csv.flush();

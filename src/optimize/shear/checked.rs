@@ -48,9 +48,14 @@ pub fn check_request(
             f.dim()
         )));
     }
-    if realizations == 1 || !(range.is_finite() && range > 0.0 && range <= MAX_SHEAR_RANGE) {
+    if realizations == 1 {
+        return Err(OptimizeError::Option(
+            "--realizations 1: the check needs 0 (no check) or at least 2".to_string(),
+        ));
+    }
+    if !(range.is_finite() && range > 0.0 && range <= MAX_SHEAR_RANGE) {
         return Err(OptimizeError::Option(format!(
-            "--realizations must be 0 (no check) or at least 2, and --range a positive number up to {MAX_SHEAR_RANGE} (got {range:?})"
+            "--range {range:?}: the search's half-width must be a positive number up to {MAX_SHEAR_RANGE}"
         )));
     }
     Ok(())
