@@ -24,11 +24,12 @@ pub fn write_csv_rows<R: Serialize>(
 
 /// The I/O error under a `csv` error, its kind kept (a closed pipe stays
 /// `BrokenPipe`, which the command line treats as success), or the error
-/// as `Other` when it is not one of I/O.
+/// as `InvalidData` when it is not one of I/O (a malformed record read, a
+/// record serde cannot write).
 pub fn csv_io_error(e: csv::Error) -> io::Error {
     match e.into_kind() {
         csv::ErrorKind::Io(cause) => cause,
-        other => io::Error::other(format!("{other:?}")),
+        other => io::Error::new(io::ErrorKind::InvalidData, format!("{other:?}")),
     }
 }
 

@@ -282,13 +282,7 @@ pub fn parse_point_sets<R: BufRead>(
         loop {
             let more = csv
                 .read_record(&mut record)
-                .map_err(|e| match e.into_kind() {
-                    csv::ErrorKind::Io(cause) => io(cause),
-                    other => io(io::Error::new(
-                        io::ErrorKind::InvalidData,
-                        format!("{other:?}"),
-                    )),
-                })?;
+                .map_err(|e| io(csv_io_error(e)))?;
             if !more {
                 break;
             }

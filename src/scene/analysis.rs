@@ -234,22 +234,19 @@ impl FootprintSlopes {
     /// samples per pixel; [κ, κ] and spread 0 unless the pixel sees one
     /// depth through a lens.
     pub fn probe(scene: &Scene, px: usize, py: usize, a: &PixelAnalysis, n: usize) -> Self {
-        let camera = scene.camera();
         let mut range = [a.kappa, a.kappa];
-        let lens = scene.integrand() == IntegrandKind::Lens && scene.has_aperture();
-        if lens && a.kind == PixelKind::Single {
+        if through_a_lens(scene) && a.kind == PixelKind::Single {
             let d0 = a.depth;
             for x in FOOTPRINT_PIXEL {
                 for y in FOOTPRINT_PIXEL {
                     for u in FOOTPRINT_LENS {
                         for v in FOOTPRINT_LENS {
-                            let ray = camera.ray(px, py, [x, y, u, v]);
-                            let hit = scene.geometry().closest(ray.origin, ray.direction, 0.0);
-                            if let Some(d) = hit.map(|h| camera.depth(h.point)) {
-                                if (d - d0).abs() <= DEPTH_TOLERANCE * d0 {
-                                    let k = camera.shear_at_depth(d);
-                                    range = [range[0].min(k), range[1].max(k)];
-                                }
+                            let depth = depth_at(scene, px, py, [x, y, u, v]);
+                            if let Some(d) =
+                                depth.filter(|d| (d - d0).abs() <= DEPTH_TOLERANCE * d0)
+                            {
+                                let k = scene.camera().shear_at_depth(d);
+                                range = [range[0].min(k), range[1].max(k)];
                             }
                         }
                     }
@@ -281,12 +278,30 @@ impl FootprintSlopes {
     }
 }
 
+/// Whether the scene's (u, v) are on a lens with an aperture (not a pinhole,
+/// not the soft-shadow integrand's light): only then does a pixel's light
+/// field have a slope κ.
+fn through_a_lens(scene: &Scene) -> bool {
+    scene.integrand() == IntegrandKind::Lens && scene.has_aperture()
+}
+
+/// The depth of the closest hit of pixel (px, py)'s ray at sample
+/// (x, y, u, v), if any.
+fn depth_at(scene: &Scene, px: usize, py: usize, sample: [f64; 4]) -> Option<f64> {
+    let camera = scene.camera();
+    let ray = camera.ray(px, py, sample);
+    scene
+        .geometry()
+        .closest(ray.origin, ray.direction, 0.0)
+        .map(|hit| camera.depth(hit.point))
+}
+
 /// Probes pixel (px, py) with 3 × 3 rays through its centre from points
 /// spread over the lens (one ray for a pinhole or the soft-shadow
 /// integrand).
 pub fn analyse_pixel(scene: &Scene, px: usize, py: usize) -> PixelAnalysis {
     let camera = scene.camera();
-    let lens = scene.integrand() == IntegrandKind::Lens && scene.has_aperture();
+    let lens = through_a_lens(scene);
     let probes: Vec<[f64; 2]> = if lens {
         PROBES
             .iter()
@@ -295,13 +310,7 @@ pub fn analyse_pixel(scene: &Scene, px: usize, py: usize) -> PixelAnalysis {
     } else {
         vec![[0.5, 0.5]]
     };
-    let depth_of = |[u, v]: [f64; 2]| {
-        let ray = camera.ray(px, py, [0.5, 0.5, u, v]);
-        scene
-            .geometry()
-            .closest(ray.origin, ray.direction, 0.0)
-            .map(|hit| camera.depth(hit.point))
-    };
+    let depth_of = |[u, v]: [f64; 2]| depth_at(scene, px, py, [0.5, 0.5, u, v]);
     let centre = depth_of([0.5, 0.5]);
     let mut depths: Vec<Option<f64>> = probes.iter().map(|&p| depth_of(p)).collect();
     depths.sort_by(|a, b| match (a, b) {
