@@ -14,11 +14,14 @@
 //! shell, or the plain mean — plus three weighted standard deviations of a
 //! fluctuation term, σ_w·√(T·max P_f)/N (using Σ_(k∉B) P_f² ≤ max P_f · T),
 //! with T the tail mass and max P_f taken over the shell. Lattices (regular
-//! grids) show large δ in the shell: when some shell frequency carries more
-//! than 20× the white-noise power (impossible for an averaged non-lattice
-//! spectrum: a single periodogram's maximum over 10⁵ frequencies is about
-//! 12), the tail is bounded by max|δ|·T/N instead, the worst case the shell
-//! shows. When most of the integrand's energy lies beyond the box (tiny
+//! grids) show large δ in the shell — N·P_S = N at their dual points: when
+//! some shell frequency carries more than max(20, N/4)× the white-noise
+//! power, the tail is bounded by max|δ|·T/N instead, the worst case the
+//! shell shows. Below that, peaks are a random set's structure, not a
+//! lattice's: a single periodogram's maximum over 10⁵ frequencies is about
+//! 12, and correlated multi-jitter's averaged spectrum has near-axis peaks
+//! of N·P_S ≈ 20, 58 and 98 at N = 256, 1024 and 4096, which the worst-case
+//! bound turned into up to 65× the variance it bounds. When most of the integrand's energy lies beyond the box (tiny
 //! disks, hairlines, k₀ outside B) the shell's max P_f says nothing about
 //! the outside and the fluctuation term uses Σ_(k∉B) P_f² ≤ T² instead: the
 //! bound is then wide, and says so. When the whole shell is dark (every
@@ -44,7 +47,7 @@ use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power_with};
 use crate::sum::NeumaierSum;
 
 /// Shell deviation |N·P_S − 1| above which the spectrum is treated as a
-/// lattice's (see the module doc).
+/// lattice's, when N/4 is smaller (see the module doc).
 const LATTICE_SPIKE: f64 = 20.0;
 /// Shell power N·P_S below which every shell frequency counts as dark (see
 /// the module doc).
@@ -246,7 +249,7 @@ where
     };
     let worst = shell.iter().map(|s| s.0.abs()).fold(0.0, f64::max);
     let dark = !shell.is_empty() && shell.iter().all(|s| s.0 + 1.0 < DARK_SHELL);
-    let truncation_bound = if worst > LATTICE_SPIKE {
+    let truncation_bound = if worst > LATTICE_SPIKE.max(0.25 * nf) {
         worst * tail_mass / nf
     } else if dark {
         // |S(k)|² ≤ c² for c points: N·P_S = |S|²/λ ≤ c²/λ beyond the box.
