@@ -45,11 +45,22 @@ fn renders_are_identical_on_one_and_two_threads_and_write_every_output() {
             ],
             Some(threads),
         );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{stderr}");
+        // The closing line names every file written, not only the PNG.
+        for name in [
+            "img.png",
+            "img.pfm",
+            "img.npy",
+            "var.png",
+            "var.pfm",
+            "var.npy",
+            "an.csv",
+            "shear.png",
+            "sum.json",
+        ] {
+            assert!(stderr.contains(&p(name)), "{name} not reported: {stderr}");
+        }
         (
             std::fs::read(p("img.pfm")).unwrap(),
             std::fs::read(p("var.pfm")).unwrap(),

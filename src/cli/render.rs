@@ -26,9 +26,9 @@ pub struct Args {
     /// Any 4D sampler of the registry, with `name:key=value` parameters.
     #[arg(long, default_value = "umj")]
     sampler: String,
-    /// Samples per pixel (the sampler's N; umj needs a square). `-n`/`--n`
-    /// as in every other command.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'n', long, visible_alias = "n", default_value_t = 16)]
+    /// Samples per pixel (the sampler's N). `-n`/`--n` as in every other
+    /// command.
+    #[arg(value_parser = super::args::count, allow_negative_numbers = true, short = 'n', long, visible_alias = "n", default_value_t = 16)]
     spp: usize,
     /// Shear of each pixel's set: none; analytic (the warp following the
     /// centre depth's light field); pilot (analytic on single-depth pixels;
@@ -299,7 +299,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None => String::new(),
         }
     );
-    eprintln!("wrote {}", output.display());
+    let written: Vec<String> = [
+        Some(output.as_path()),
+        a.pfm.as_deref(),
+        a.npy.as_deref(),
+        a.variance_png.as_deref(),
+        a.variance_pfm.as_deref(),
+        a.variance_npy.as_deref(),
+        a.analysis.as_deref(),
+        a.shear_png.as_deref(),
+        a.summary.as_deref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(|p| p.display().to_string())
+    .collect();
+    eprintln!("wrote {}", written.join(", "));
     Ok(())
 }
 
