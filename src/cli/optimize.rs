@@ -711,7 +711,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
 
 fn shear(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::integrands;
-    use varspec::optimize::shear::checked::{check_request, search_and_check};
+    use varspec::optimize::shear::checked::{CheckVerdict, check_request, search_and_check};
     use varspec::optimize::shear::shear_set;
     // The pictures --png-prefix names (a pixel also gets its light field's).
     let pictures: Vec<std::path::PathBuf> = a
@@ -801,6 +801,15 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                 after.ci_high
             );
         }
+    }
+    match run.verdict {
+        Some(CheckVerdict::Contradicts) => eprintln!(
+            "warning: the fresh-set check finds the shear worse than none (95% intervals apart), against the search's objective: do not use it; try another --seed, or keep the sets unsheared"
+        ),
+        Some(CheckVerdict::Inconclusive) if !a.json => println!(
+            "the check cannot tell the shear from none (95% intervals overlap): raise --realizations to separate them"
+        ),
+        _ => {}
     }
     Ok(())
 }

@@ -15,6 +15,44 @@ use crate::rng::set_rng;
 use crate::samplers::Sampler;
 use crate::variance::{EmpiricalEstimate, VarianceError, empirical_shifting};
 
+/// What the fresh-set check says of the search's claim that the shear
+/// lowers the variance, from the two 95% intervals.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CheckVerdict {
+    /// The sheared interval lies wholly below the unsheared one.
+    Confirms,
+    /// The intervals overlap: the check cannot tell them apart.
+    Inconclusive,
+    /// The sheared interval lies wholly above the unsheared one: the
+    /// objective (an estimate, for halves without a closed form) misled
+    /// the search.
+    Contradicts,
+}
+
+impl CheckVerdict {
+    /// The verdict of the check (before, after).
+    #[must_use]
+    pub fn of(before: &EmpiricalEstimate, after: &EmpiricalEstimate) -> Self {
+        if after.ci_high < before.ci_low {
+            Self::Confirms
+        } else if after.ci_low > before.ci_high {
+            Self::Contradicts
+        } else {
+            Self::Inconclusive
+        }
+    }
+
+    /// The name the JSON report uses.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Confirms => "confirms",
+            Self::Inconclusive => "inconclusive",
+            Self::Contradicts => "contradicts",
+        }
+    }
+}
+
 /// A search with its check.
 pub struct CheckedShear {
     /// The search's result.
@@ -24,6 +62,9 @@ pub struct CheckedShear {
     /// Variance of the estimator unsheared and at the found shear on
     /// fresh realizations (None for `realizations` = 0).
     pub check: Option<(EmpiricalEstimate, EmpiricalEstimate)>,
+    /// The check's verdict on the found shear (None without a check, or
+    /// when the search kept no shear: then both sides are one estimator).
+    pub verdict: Option<CheckVerdict>,
     /// Wall time of the search (without the check), seconds.
     pub search_seconds: f64,
     /// Everything, as the command's JSON report.
@@ -106,6 +147,10 @@ pub fn search_and_check(
     } else {
         None
     };
+    let verdict = check
+        .as_ref()
+        .filter(|_| found.shear != [0.0, 0.0])
+        .map(|(before, after)| CheckVerdict::of(before, after));
     let analytic = f.light_field().map(|l| l.layer_shears());
     let plane = |p: &PlaneDirections| {
         json!({"principal_slope": p.principal, "eigenvalue_ratio": p.eigenvalue_ratio,
@@ -131,6 +176,7 @@ pub fn search_and_check(
                         "b_minus": found.sensitivity[2], "b_plus": found.sensitivity[3]},
         "variance_before": check.as_ref().map(|c| ci(&c.0)),
         "variance_after": check.as_ref().map(|c| ci(&c.1)),
+        "check_verdict": verdict.map(CheckVerdict::name),
         "reduction": found.unsheared.value / found.optimum.value,
         "seconds": search_seconds,
     });
@@ -138,7 +184,45 @@ pub fn search_and_check(
         found,
         spectral,
         check,
+        verdict,
         search_seconds,
         report,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn interval(ci_low: f64, ci_high: f64) -> EmpiricalEstimate {
+        EmpiricalEstimate {
+            variance: 0.5 * (ci_low + ci_high),
+            stderr: 0.25 * (ci_high - ci_low),
+            ci_low,
+            ci_high,
+            mean: 0.0,
+            realizations: 100,
+        }
+    }
+
+    #[test]
+    fn the_verdict_needs_the_intervals_apart() {
+        let before = interval(2.0, 3.0);
+        assert_eq!(
+            CheckVerdict::of(&before, &interval(1.0, 1.9)),
+            CheckVerdict::Confirms
+        );
+        assert_eq!(
+            CheckVerdict::of(&before, &interval(1.0, 2.1)),
+            CheckVerdict::Inconclusive
+        );
+        assert_eq!(
+            CheckVerdict::of(&before, &interval(2.9, 4.0)),
+            CheckVerdict::Inconclusive
+        );
+        assert_eq!(
+            CheckVerdict::of(&before, &interval(3.1, 4.0)),
+            CheckVerdict::Contradicts
+        );
+    }
 }
