@@ -199,6 +199,12 @@ fn duplicates_after_adjustment_are_refused_naming_the_values() {
             SMALL.replace("\"half\": 20", "\"halfwidth\": 20"),
             "unknown field `halfwidth`",
         ),
+        // A value of the wrong type: the path of the field, not only a
+        // line and column.
+        (
+            SMALL.replace("\"half\": 20", "\"half\": -3"),
+            "radial.half: invalid value: integer `-3`",
+        ),
     ];
     refused_without_a_folder("experiment-duplicates", &cases);
 }

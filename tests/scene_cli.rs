@@ -172,6 +172,11 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
             "\"ambiant\": 1.0",
             "unknown field `ambiant`",
         ),
+        (
+            "\"subdivisions\": 4",
+            "\"subdivisions\": \"four\"",
+            "objects[2].subdivisions: invalid type: string \"four\"",
+        ),
     ];
     for (from, to, phrase) in cases {
         assert!(base.contains(from), "{from}");

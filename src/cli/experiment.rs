@@ -136,8 +136,8 @@ pub fn merge(a: MergeArgs) -> anyhow::Result<()> {
     for p in &paths {
         let text = varspec::io::read_text_bounded(p, 1 << 30, "an experiment shard")
             .with_context(|| format!("cannot read {}", p.display()))?;
-        let shard: ShardFile = serde_json::from_str(&text)
-            .with_context(|| format!("{}: not a shard file", p.display()))?;
+        let shard: ShardFile = varspec::io::from_json(&text)
+            .map_err(|e| anyhow::anyhow!("{}: not a shard file: {e}", p.display()))?;
         shards.push(shard);
     }
     let (e, file, cells) = merge_shards(&shards)?;

@@ -225,8 +225,8 @@ fn read_table_shards(output: &std::path::Path) -> anyhow::Result<Vec<TableShard>
         .map(|p| {
             let text = varspec::io::read_text_bounded(p, 1 << 34, "a table shard")
                 .with_context(|| format!("cannot read {}", p.display()))?;
-            serde_json::from_str(&text)
-                .with_context(|| format!("{}: not a table shard", p.display()))
+            varspec::io::from_json(&text)
+                .map_err(|e| anyhow::anyhow!("{}: not a table shard: {e}", p.display()))
         })
         .collect()
 }

@@ -300,7 +300,7 @@ impl FigureExperiment {
             file: file.to_string(),
             reason,
         };
-        let e: FigureExperiment = serde_json::from_str(text)
+        let e: FigureExperiment = crate::io::from_json(text)
             .map_err(|err| invalid(format!("not a valid figure experiment: {err}")))?;
         plain_name(&e.name).map_err(invalid)?;
         if e.kind != "figures" {

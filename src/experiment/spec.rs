@@ -111,7 +111,7 @@ impl Experiment {
     /// # Errors
     /// [`ExperimentError::Invalid`] naming the file and the rule broken.
     pub fn parse(text: &str, file: &str) -> Result<Self, ExperimentError> {
-        let e: Experiment = serde_json::from_str(text).map_err(|err| ExperimentError::Invalid {
+        let e: Experiment = crate::io::from_json(text).map_err(|err| ExperimentError::Invalid {
             file: file.to_string(),
             reason: format!("not a valid experiment: {err}"),
         })?;

@@ -3,6 +3,7 @@
 pub mod atomic;
 pub mod bounded;
 pub mod csv_rows;
+pub mod json;
 pub mod npy;
 pub mod pointfile;
 pub mod tables;
@@ -12,6 +13,7 @@ pub use atomic::{
 };
 pub use bounded::{read_bounded, read_text_bounded};
 pub use csv_rows::write_csv_rows;
+pub use json::from_json;
 pub use pointfile::{PointFileError, PointFormat, read_point_sets, write_point_sets};
 
 /// Writes point sets to `path` atomically, as NumPy `.npy` when its

@@ -194,8 +194,8 @@ pub enum SceneError {
         /// Why.
         cause: std::io::Error,
     },
-    /// Malformed JSON or a field of the wrong type (serde's message names
-    /// the field, line and column).
+    /// Malformed JSON or a field of the wrong type (the message names the
+    /// field, line and column).
     #[error("{source_name}: {message}")]
     Syntax {
         /// File or built-in name.
@@ -238,10 +238,11 @@ impl SceneFile {
     /// # Errors
     /// [`SceneError::Syntax`] or [`SceneError::Field`].
     pub fn parse(text: &str, source_name: &str) -> Result<SceneFile, SceneError> {
-        let scene: SceneFile = serde_json::from_str(text).map_err(|e| SceneError::Syntax {
-            source_name: source_name.into(),
-            message: e.to_string(),
-        })?;
+        let scene: SceneFile =
+            crate::io::from_json(text).map_err(|message| SceneError::Syntax {
+                source_name: source_name.into(),
+                message,
+            })?;
         scene.check(source_name)?;
         Ok(scene)
     }
