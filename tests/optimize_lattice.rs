@@ -233,3 +233,51 @@ fn cmj_variance(spec: &str, n: usize, seed: u64) -> SpatialEstimate {
     })
     .unwrap()
 }
+
+/// The reduced basis's shortest dual vector equals the shortest found by
+/// enumerating the dual points k·x ∈ Z for every point x of the lattice
+/// (|k|∞ ≤ N), for every lattice of several N.
+#[test]
+fn the_shortest_dual_vector_is_the_enumerated_one() {
+    for n in [12, 64, 89, 100] {
+        for l in lattices(n) {
+            let points = l.points([0.0, 0.0]);
+            let on_dual = |k: [i64; 2]| {
+                points.points().all(|x| {
+                    let t = k[0] as f64 * x[0] + k[1] as f64 * x[1];
+                    (t - t.round()).abs() < 1e-9
+                })
+            };
+            let span = n as i64;
+            let shortest = (-span..=span)
+                .flat_map(|k0| (-span..=span).map(move |k1| [k0, k1]))
+                .filter(|&k| k != [0, 0] && on_dual(k))
+                .map(|k| k[0] * k[0] + k[1] * k[1])
+                .min()
+                .unwrap();
+            let h = l.shortest_dual();
+            assert!(on_dual(h), "{l:?}: {h:?} is not a dual vector");
+            assert_eq!(h[0] * h[0] + h[1] * h[1], shortest, "{l:?}: {h:?}");
+        }
+    }
+}
+
+/// A cosine of frequency (3, 2) is integrated exactly by every lattice
+/// whose dual misses ±(3, 2): the tie goes to the lattice best for
+/// integrands in general, not to the first listed (64 points on one
+/// vertical line, shortest dual vector (1, 0)).
+#[test]
+fn lattices_tied_on_the_target_go_to_the_most_two_dimensional() {
+    let f = integrands::parse("cos:kx=3,ky=2").unwrap();
+    let found = best_lattice(64, f.as_ref()).unwrap();
+    let h = found.lattice.shortest_dual();
+    let length = ((h[0] * h[0] + h[1] * h[1]) as f64).sqrt();
+    // The hexagonal bound √(2N/√3) = 8.6 for N = 64; no lattice of 64
+    // points exceeds it, and the best integer ones reach 8.06 (|(7, 4)|).
+    assert!(
+        length >= 8.0,
+        "{:?}: shortest dual vector {h:?} (|h| = {length:.2})",
+        found.lattice
+    );
+    assert!(found.variance <= found.rounding_bound, "{found:?}");
+}

@@ -274,13 +274,17 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         },
     })?;
     if let Some(found) = plan.lattice() {
+        let h = found.lattice.shortest_dual();
         println!(
-            "start: the best of {} integration lattices of {} points (dual basis ({}, 0), ({}, {})), exact variance {:.4e}",
+            "start: the best of {} integration lattices of {} points (dual basis ({}, 0), ({}, {}); shortest dual vector ({}, {}): on lines {:.3} apart), exact variance {:.4e}",
             found.candidates,
             a.n,
             found.lattice.a,
             found.lattice.b,
             found.lattice.c,
+            h[0],
+            h[1],
+            1.0 / ((h[0] * h[0] + h[1] * h[1]) as f64).sqrt(),
             found.variance
         );
         if let Some((sum, half)) = found.dual_sum {

@@ -101,6 +101,30 @@ impl Lattice {
         )
     }
 
+    /// The shortest nonzero vector h of the dual lattice (Lagrange–Gauss
+    /// reduction of the basis (a, 0), (b, c); Nguyen & Stehlé 2009, Alg. 1):
+    /// the points lie on parallel lines h·x ∈ Z + s, 1/|h| apart, so |h| is
+    /// the lattice's figure of merit for integrands in general — the
+    /// spectral test (Knuth, TAOCP vol. 2, §3.3.4), √(2N/√3) at best (the
+    /// hexagonal lattice), 1 for N points on one line.
+    pub fn shortest_dual(&self) -> [i64; 2] {
+        let norm = |v: [i64; 2]| v[0] * v[0] + v[1] * v[1];
+        let (mut u, mut v) = ([self.a as i64, 0], [self.b as i64, self.c as i64]);
+        if norm(u) > norm(v) {
+            std::mem::swap(&mut u, &mut v);
+        }
+        loop {
+            // v − round(⟨u, v⟩/|u|²)·u, then swap while it got shorter.
+            let dot = u[0] * v[0] + u[1] * v[1];
+            let q = (dot as f64 / norm(u) as f64).round() as i64;
+            v = [v[0] - q * u[0], v[1] - q * u[1]];
+            if norm(v) >= norm(u) {
+                return u;
+            }
+            std::mem::swap(&mut u, &mut v);
+        }
+    }
+
     /// Σ P_f(k) over the dual lattice in 0 < |k|∞ ≤ `half` (a lower bound of
     /// the variance, used to screen).
     fn dual_sum(&self, f: &dyn Integrand, half: i64) -> f64 {
@@ -169,7 +193,11 @@ pub fn lattices(n: usize) -> Vec<Lattice> {
 }
 
 /// The integration lattice of `n` points with the smallest shift-randomized
-/// variance for `f` (ties to the first in [`lattices`] order).
+/// variance for `f`. Ties (a smooth f, e.g. a cosine, is integrated exactly
+/// by most lattices) go to the lattice with the longest shortest dual
+/// vector ([`Lattice::shortest_dual`]: the one best for integrands in
+/// general, not N points on one line), then to the first in [`lattices`]
+/// order.
 ///
 /// # Errors
 /// [`OptimizeError::Option`] for N = 0 or above [`MAX_POINTS`], or a
@@ -205,10 +233,18 @@ pub fn best_lattice(n: usize, f: &dyn Integrand) -> Result<LatticeDesign, Optimi
         keep.into_iter().map(|i| all[i]).collect()
     };
     let ranked: Vec<(f64, f64)> = finalists.par_iter().map(|l| l.variance(f)).collect();
+    let spread = |i: usize| {
+        let h = finalists[i].shortest_dual();
+        h[0] * h[0] + h[1] * h[1]
+    };
     let first_min = |scores: &[(usize, f64)]| {
         scores
             .iter()
-            .min_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)))
+            .min_by(|x, y| {
+                x.1.total_cmp(&y.1)
+                    .then(spread(y.0).cmp(&spread(x.0)))
+                    .then(x.0.cmp(&y.0))
+            })
             .map(|s| s.0)
             .expect("at least the N x 1 lattice")
     };
