@@ -283,7 +283,7 @@ fn a_dual_ring_just_beyond_the_box_is_inside_the_error_bar() {
 /// Structure that is not a lattice: correlated multi-jitter's shared
 /// shuffles give its averaged spectrum peaks near the axes (N·P_S ≈ 58 at
 /// N = 1024, far below a lattice's N at its dual points). Read as lattice
-/// spikes, they made the truncation bound the worst case max|δ|·T/N: 16×
+/// spikes, they made the truncation bound the worst case max|δ|·T/N: 17×
 /// the variance it bounds, while the Fourier form's error is 9% of it.
 /// The bound must still cover that error and be of its order.
 #[test]
