@@ -8,7 +8,9 @@ use varspec::PointSet;
 use varspec::integrands;
 use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::variance::{VarianceError, empirical, fourier, spatial};
+use varspec::variance::{
+    FourierEstimate, SpatialEstimate, VarianceError, empirical, fourier, spatial,
+};
 
 /// z for the empirical comparisons (per-check two-sided rate 6.8e-6).
 const Z: f64 = 4.5;
@@ -246,14 +248,13 @@ fn predictors_refuse_sets_without_points() {
 /// error bar users see) must still cover the exact spatial form.
 #[test]
 fn a_dual_ring_just_beyond_the_box_is_inside_the_error_bar() {
-    let f = integrands::parse("halfplane:angle=17,offset=0.07").unwrap();
-    let sampler = registry::build("uniform-jitter", 1024, Some(2), &[]).unwrap();
-    let sets: Vec<PointSet> = (0..4)
-        .map(|r| sampler.sample(&mut set_rng(77, r)).unwrap())
-        .collect();
-    let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(sets[r].clone()) };
-    let s = spatial(f.as_ref(), sets.len(), lend).unwrap();
-    let four = fourier(f.as_ref(), 31, 1e-12, sets.len(), lend).unwrap();
+    let (four, s) = fourier_beside_spatial(
+        "halfplane:angle=17,offset=0.07",
+        "uniform-jitter",
+        1024,
+        (77, 4),
+        31,
+    );
     let gap = (four.variance - s.variance).abs();
     // Measured before the dark-shell rule: Fourier 3.6e-6 against the exact
     // 8.8e-5, with a bound of 7.2e-6.
@@ -271,13 +272,7 @@ fn a_dual_ring_just_beyond_the_box_is_inside_the_error_bar() {
         "bound {:e}, expected the rigorous (N − 1)·T/N = {rigorous:e}",
         four.truncation_bound
     );
-    assert!(
-        gap <= four.truncation_bound + s.rounding_bound,
-        "Fourier {:e} vs spatial {:e}: gap {gap:e} outside the truncation bound {:e}",
-        four.variance,
-        s.variance,
-        four.truncation_bound
-    );
+    assert_within_truncation_bound(&four, &s);
 }
 
 /// Structure that is not a lattice: correlated multi-jitter's shared
@@ -288,14 +283,8 @@ fn a_dual_ring_just_beyond_the_box_is_inside_the_error_bar() {
 /// The bound must still cover that error and be of its order.
 #[test]
 fn correlated_multi_jitter_peaks_are_not_lattice_spikes() {
-    let f = integrands::parse("halfplane:angle=30,offset=0.1").unwrap();
-    let sampler = registry::build("cmj", 1024, Some(2), &[]).unwrap();
-    let sets: Vec<PointSet> = (0..8)
-        .map(|r| sampler.sample(&mut set_rng(5, r)).unwrap())
-        .collect();
-    let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(sets[r].clone()) };
-    let s = spatial(f.as_ref(), sets.len(), lend).unwrap();
-    let four = fourier(f.as_ref(), 128, 1e-12, sets.len(), lend).unwrap();
+    let (four, s) =
+        fourier_beside_spatial("halfplane:angle=30,offset=0.1", "cmj", 1024, (5, 8), 128);
     let gap = (four.variance - s.variance).abs();
     assert!(
         gap > 0.02 * s.variance,
@@ -303,17 +292,45 @@ fn correlated_multi_jitter_peaks_are_not_lattice_spikes() {
         four.variance,
         s.variance
     );
+    assert_within_truncation_bound(&four, &s);
+    assert!(
+        four.truncation_bound <= 10.0 * gap,
+        "bound {:e} is more than 10× the error {gap:e} it bounds (variance {:e})",
+        four.truncation_bound,
+        s.variance
+    );
+}
+
+/// The Fourier form (box half-width `half`, NUFFT tolerance 1e-12) and the
+/// exact spatial form of `spec` on the same realizations of `sampler`
+/// (`(seed, sets)`) of `n` points.
+fn fourier_beside_spatial(
+    spec: &str,
+    sampler: &str,
+    n: usize,
+    (seed, count): (u64, u64),
+    half: usize,
+) -> (FourierEstimate, SpatialEstimate) {
+    let f = integrands::parse(spec).unwrap();
+    let sampler = registry::build(sampler, n, Some(2), &[]).unwrap();
+    let sets: Vec<PointSet> = (0..count)
+        .map(|r| sampler.sample(&mut set_rng(seed, r)).unwrap())
+        .collect();
+    let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(sets[r].clone()) };
+    let s = spatial(f.as_ref(), sets.len(), lend).unwrap();
+    let four = fourier(f.as_ref(), half, 1e-12, sets.len(), lend).unwrap();
+    (four, s)
+}
+
+/// The Fourier form's distance from the exact spatial form lies within
+/// its truncation bound (plus the spatial form's rounding).
+fn assert_within_truncation_bound(four: &FourierEstimate, s: &SpatialEstimate) {
+    let gap = (four.variance - s.variance).abs();
     assert!(
         gap <= four.truncation_bound + s.rounding_bound,
         "Fourier {:e} vs spatial {:e}: gap {gap:e} outside the truncation bound {:e}",
         four.variance,
         s.variance,
         four.truncation_bound
-    );
-    assert!(
-        four.truncation_bound <= 10.0 * gap,
-        "bound {:e} is more than 10× the error {gap:e} it bounds (variance {:e})",
-        four.truncation_bound,
-        s.variance
     );
 }

@@ -88,6 +88,23 @@ pub struct Args {
     list: bool,
 }
 
+impl Args {
+    /// The files asked for beside the tone-mapped image, in the order the
+    /// closing line names them.
+    fn side_outputs(&self) -> [Option<&std::path::Path>; 8] {
+        [
+            self.pfm.as_deref(),
+            self.npy.as_deref(),
+            self.variance_png.as_deref(),
+            self.variance_pfm.as_deref(),
+            self.variance_npy.as_deref(),
+            self.analysis.as_deref(),
+            self.shear_png.as_deref(),
+            self.summary.as_deref(),
+        ]
+    }
+}
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     if a.list {
         for (name, about, _) in BUILTIN_SCENES {
@@ -126,17 +143,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }
         }
     };
-    args::check_outputs([
-        a.output.as_deref(),
-        a.pfm.as_deref(),
-        a.variance_png.as_deref(),
-        a.variance_pfm.as_deref(),
-        a.npy.as_deref(),
-        a.variance_npy.as_deref(),
-        a.summary.as_deref(),
-        a.analysis.as_deref(),
-        a.shear_png.as_deref(),
-    ])?;
+    args::check_outputs(std::iter::once(a.output.as_deref()).chain(a.side_outputs()))?;
     let scene = Scene::load(&a.scene)?;
     // Every thread holds one pixel's set (and its sheared copy) at a time.
     varspec::memory::check(
@@ -299,21 +306,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None => String::new(),
         }
     );
-    let written: Vec<String> = [
-        Some(output.as_path()),
-        a.pfm.as_deref(),
-        a.npy.as_deref(),
-        a.variance_png.as_deref(),
-        a.variance_pfm.as_deref(),
-        a.variance_npy.as_deref(),
-        a.analysis.as_deref(),
-        a.shear_png.as_deref(),
-        a.summary.as_deref(),
-    ]
-    .into_iter()
-    .flatten()
-    .map(|p| p.display().to_string())
-    .collect();
+    let written: Vec<String> = std::iter::once(Some(output.as_path()))
+        .chain(a.side_outputs())
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
     eprintln!("wrote {}", written.join(", "));
     Ok(())
 }
