@@ -9,9 +9,7 @@
 
 use rustfft::num_complex::Complex64;
 
-use super::{
-    Disk, Gaussian, Integrand, IntegrandClass, IntegrandError, LightField, PlaneWave, Rect, sinc_pi,
-};
+use super::{Disk, Gaussian, Integrand, IntegrandClass, IntegrandError, LightField, Rect, sinc_pi};
 use crate::points::wrap01;
 
 /// The 2D shape g of a defocus light field.
@@ -98,17 +96,14 @@ impl Defocus {
 
 /// φ_k(u, v) = G(k)·e^(2πi c k·((u,v) − ½)): one plane wave of frequency c·k.
 impl LightField for Defocus {
-    fn plane_waves(&self, k: [i64; 2], out: &mut Vec<PlaneWave>) {
-        let c = self.c;
-        out.push(PlaneWave {
-            amplitude: self.g.fourier(&k)
-                * crate::spectrum::pair::turn(-0.5 * c * (k[0] + k[1]) as f64),
-            frequency: [c * k[0] as f64, c * k[1] as f64],
-        });
+    fn wave_slopes(&self) -> Vec<[f64; 2]> {
+        vec![[self.c, self.c]]
     }
 
-    fn layer_shears(&self) -> Vec<[f64; 2]> {
-        vec![[-self.c, -self.c]]
+    fn wave_amplitudes(&self, k: [i64; 2], out: &mut Vec<Complex64>) {
+        out.push(
+            self.g.fourier(&k) * crate::spectrum::pair::turn(-0.5 * self.c * (k[0] + k[1]) as f64),
+        );
     }
 
     fn layer_shapes(&self) -> Vec<String> {

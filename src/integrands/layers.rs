@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 
 use rustfft::num_complex::Complex64;
 
-use super::{Defocus, DefocusShape, Integrand, IntegrandClass, LightField, PlaneWave, sinc_pi};
+use super::{Defocus, DefocusShape, Integrand, IntegrandClass, LightField, sinc_pi};
 
 /// Frequencies per axis of the series for the layers' cross term.
 const CROSS_HALF: i64 = 256;
@@ -132,18 +132,18 @@ impl Integrand for Layers {
 }
 
 impl LightField for Layers {
-    fn plane_waves(&self, k: [i64; 2], out: &mut Vec<PlaneWave>) {
-        for (layer, w) in self.layers.iter().zip(self.weights()) {
-            let start = out.len();
-            layer.plane_waves(k, out);
-            for wave in &mut out[start..] {
-                wave.amplitude *= w;
-            }
-        }
+    fn wave_slopes(&self) -> Vec<[f64; 2]> {
+        self.layers.iter().flat_map(|l| l.wave_slopes()).collect()
     }
 
-    fn layer_shears(&self) -> Vec<[f64; 2]> {
-        self.layers.iter().flat_map(|l| l.layer_shears()).collect()
+    fn wave_amplitudes(&self, k: [i64; 2], out: &mut Vec<Complex64>) {
+        for (layer, w) in self.layers.iter().zip(self.weights()) {
+            let start = out.len();
+            layer.wave_amplitudes(k, out);
+            for a in &mut out[start..] {
+                *a *= w;
+            }
+        }
     }
 
     fn layer_shapes(&self) -> Vec<String> {

@@ -12,19 +12,45 @@
 
 pub use crate::spectrum::pair::PlaneWave;
 use crate::spectrum::pair::uniform_char;
+use rustfft::num_complex::Complex64;
 
-/// A 4D integrand in light-field form. Its (x, y) average φ_0 must not
-/// depend on (u, v) (ω_t(0) = 0), so the (x, y)-shifted estimator is
-/// unbiased for every pairing of (x, y) and (u, v).
+/// A 4D integrand in light-field form: a stack of sheared layers, wave t
+/// of φ_k having the frequency ω_t(k) = (s_t,x·k_x, s_t,y·k_y) for a fixed
+/// slope s_t (a layer of shear c has s = (c, c)). So ω_t(0) = 0: the
+/// (x, y) average φ_0 does not depend on (u, v), and the (x, y)-shifted
+/// estimator is unbiased for every pairing of (x, y) and (u, v).
 pub trait LightField: Send + Sync {
-    /// Appends the plane waves of φ_k to `out`.
-    fn plane_waves(&self, k: [i64; 2], out: &mut Vec<PlaneWave>);
-    /// The shear (a, b) that makes each layer constant along (u, v): the
-    /// analytic answer a = b = −c for a layer of shear c.
-    fn layer_shears(&self) -> Vec<[f64; 2]>;
+    /// The slope s_t of each wave.
+    fn wave_slopes(&self) -> Vec<[f64; 2]>;
+    /// Appends the amplitudes A_t(k) of φ_k to `out`, one per slope, in
+    /// the order of [`Self::wave_slopes`].
+    fn wave_amplitudes(&self, k: [i64; 2], out: &mut Vec<Complex64>);
     /// The 2D shape g of each layer, as a catalogue spec (in the order of
-    /// [`Self::layer_shears`]).
+    /// [`Self::wave_slopes`]).
     fn layer_shapes(&self) -> Vec<String>;
+    /// Appends the plane waves of φ_k to `out`: amplitudes with their
+    /// frequencies s_t ⊙ k.
+    fn plane_waves(&self, k: [i64; 2], out: &mut Vec<PlaneWave>) {
+        let mut amplitudes = Vec::new();
+        self.wave_amplitudes(k, &mut amplitudes);
+        out.extend(
+            amplitudes
+                .into_iter()
+                .zip(self.wave_slopes())
+                .map(|(amplitude, s)| PlaneWave {
+                    amplitude,
+                    frequency: [s[0] * k[0] as f64, s[1] * k[1] as f64],
+                }),
+        );
+    }
+    /// The shear (a, b) that makes each layer constant along (u, v): the
+    /// analytic answer a = b = −c for a layer of shear c, −s_t.
+    fn layer_shears(&self) -> Vec<[f64; 2]> {
+        self.wave_slopes()
+            .into_iter()
+            .map(|s| [-s[0], -s[1]])
+            .collect()
+    }
 }
 
 /// ∫∫ |φ_k(u, v)|² du dv = Σ_(t,t′) A_t·conj(A_t′)·χ(ω_t − ω_t′), χ the
