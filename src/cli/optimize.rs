@@ -23,7 +23,7 @@ pub enum OptimizeCommand {
     /// Move points to minimize Σ W(k)·P_S(k) for a target weight W.
     Points(PointsArgs),
     /// Shear a structured 4D sampler (x += a·u, y += b·v) to minimize the
-    /// unshifted estimator's variance on a 4D integrand.
+    /// variance of the (x, y)-shifted estimator on a 4D integrand.
     Shear(ShearArgs),
 }
 
