@@ -12,6 +12,7 @@
 //! than no shear: if J(found) ≥ J(0, 0), the search returns (0, 0).
 
 pub mod checked;
+mod layer_sums;
 pub mod objective;
 pub mod start;
 
@@ -178,8 +179,8 @@ pub fn search_shear(
 }
 
 /// Minimizes J along a line from `t0`: a scan of the whole range at step
-/// [`COARSE_STEP`], then scans of ±10 points around the best at steps 0.01
-/// and 0.001, then Brent's method within one last step.
+/// [`COARSE_STEP`], a scan of ±10 points around the best at step 0.01, then
+/// Brent's method within one step of the best.
 fn refine_line(line: &Line, t0: f64, range: f64) -> Result<(f64, f64), OptimizeError> {
     let mut best = (t0, line.at(t0));
     let coarse = (range / COARSE_STEP).ceil() as i32;
@@ -190,19 +191,15 @@ fn refine_line(line: &Line, t0: f64, range: f64) -> Result<(f64, f64), OptimizeE
             best = (t, v);
         }
     }
-    let mut step = 0.1 * COARSE_STEP;
-    for _ in 0..2 {
-        let centre = best.0;
-        for i in -SCAN_POINTS..=SCAN_POINTS {
-            let t = (centre + step * i as f64).clamp(-range, range);
-            let v = line.at(t);
-            if v < best.1 {
-                best = (t, v);
-            }
+    let step = 0.1 * COARSE_STEP;
+    let centre = best.0;
+    for i in -SCAN_POINTS..=SCAN_POINTS {
+        let t = (centre + step * i as f64).clamp(-range, range);
+        let v = line.at(t);
+        if v < best.1 {
+            best = (t, v);
         }
-        step *= 0.1;
     }
-    let step = step * 10.0;
     let (lo, hi) = ((best.0 - step).max(-range), (best.0 + step).min(range));
     if hi > lo {
         let brent = BrentOpt::new(lo, hi).set_tolerance(1e-8, 1e-12);

@@ -23,7 +23,8 @@
 //! second is what the two halves' correlations buy. Where both halves have
 //! closed forms (random, jitter, multi-jitter, CMJ) J is exact up to the
 //! truncation of the sum, which is reported as a bound; other halves are
-//! estimated from realizations with a standard error.
+//! estimated from realizations with a standard error, the (u, v) half's
+//! pair sums by powers of one phasor per point ([`super::layer_sums`]).
 //!
 //! At the shear a = b = −c of a single defocus layer, σ_k cancels ω(k) = c·k,
 //! C(0, 0) = N(N − 1) and J = Σ_k |G(k)|² p_k / N: the (x, y) set integrates
@@ -35,10 +36,12 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
 
 use super::super::OptimizeError;
+use super::layer_sums::{LayerSums, Scratch};
 use crate::integrands::{Integrand, LightField, PlaneWave, light_field_energy};
+use crate::points::PointSet;
 use crate::rng::set_rng;
 use crate::samplers::Sampler;
-use crate::spectrum::pair::{EmpiricalPairs, PairSpectrum};
+use crate::spectrum::pair::PairSpectrum;
 use crate::spectrum::{FrequencyBox, Method, expected_power_with};
 use crate::sum::NeumaierSum;
 
@@ -74,7 +77,7 @@ impl Default for ObjectiveOptions {
         ObjectiveOptions {
             truncation: 0.01,
             stderr: 0.01,
-            min_realizations: 64,
+            min_realizations: 16,
             max_realizations: 4096,
             seed: 0,
         }
@@ -102,17 +105,28 @@ enum XyPower {
     },
 }
 
-/// The (u, v) half's expected pair sums.
+/// The (u, v) half's expected pair sums: a closed form, or realizations.
 enum UvPairs<'a> {
     Exact(&'a dyn PairSpectrum),
-    Empirical(EmpiricalPairs),
+    Empirical(UvRealizations),
 }
 
-impl UvPairs<'_> {
-    fn spectrum(&self) -> &dyn PairSpectrum {
-        match self {
-            UvPairs::Exact(s) => *s,
-            UvPairs::Empirical(e) => e,
+/// Realizations of the (u, v) half and their diagonals Σ_l |ψ_k(q_l)|²,
+/// which no shear changes, for the current terms.
+struct UvRealizations {
+    sets: Vec<PointSet>,
+    /// Σ_k coefficient·diagonal, per realization.
+    weighted_diagonal: Vec<f64>,
+    /// The mean diagonal over the realizations, per term.
+    mean_diagonal: Vec<f64>,
+}
+
+impl UvRealizations {
+    fn new(sets: Vec<PointSet>) -> Self {
+        UvRealizations {
+            sets,
+            weighted_diagonal: Vec::new(),
+            mean_diagonal: Vec::new(),
         }
     }
 }
@@ -126,6 +140,8 @@ pub struct ShearObjective<'a> {
     xy: XyPower,
     uv: UvPairs<'a>,
     terms: Vec<Term>,
+    /// The terms as a table of powers, for an estimated (u, v) half.
+    layer_sums: LayerSums,
     half: usize,
     truncation_bound: f64,
     seed: u64,
@@ -176,14 +192,16 @@ impl<'a> ShearObjective<'a> {
                 "the shear search needs at least 2 points per set".into(),
             ));
         }
-        let mut realizations = options.min_realizations.max(2);
+        // Realizations of the (x, y) and (u, v) halves, grown separately.
+        let mut counts = [options.min_realizations.max(2); 2];
         loop {
+            let [xy_count, uv_count] = counts;
             let uv = match uv_half.pair_spectrum() {
                 Some(s) => UvPairs::Exact(s),
-                None => UvPairs::Empirical(EmpiricalPairs::new(draw(
+                None => UvPairs::Empirical(UvRealizations::new(draw(
                     uv_half,
                     options.seed ^ UV_STREAM,
-                    realizations,
+                    uv_count,
                 )?)),
             };
             let xy = match xy_half.pair_spectrum() {
@@ -197,7 +215,7 @@ impl<'a> ShearObjective<'a> {
                     let (spectrum, _) = expected_power_with(
                         freqs,
                         Method::Fast { tolerance: 1e-10 },
-                        realizations,
+                        xy_count,
                         |r| {
                             xy_half
                                 .sample(&mut set_rng(seed, r as u64))
@@ -209,7 +227,7 @@ impl<'a> ShearObjective<'a> {
                     XyPower::Empirical {
                         freqs,
                         power: spectrum.power,
-                        sets: realizations,
+                        sets: xy_count,
                     }
                 }
             };
@@ -220,6 +238,7 @@ impl<'a> ShearObjective<'a> {
                 xy,
                 uv,
                 terms: Vec::new(),
+                layer_sums: LayerSums::new(&[], Vec::new(), light.wave_slopes()),
                 half: 0,
                 truncation_bound: 0.0,
                 seed: options.seed,
@@ -235,13 +254,24 @@ impl<'a> ShearObjective<'a> {
                 .copied()
                 .find(|s| objective.value(s[0], s[1]) == best)
                 .unwrap_or([0.0, 0.0]);
-            let relative = objective.evaluate(at)?.stderr / best.abs().max(f64::MIN_POSITIVE);
-            if relative <= options.stderr || realizations >= options.max_realizations {
+            // Each half gets half the target variance; a half over its
+            // share grows by the ratio (the variance falls as 1/R).
+            let (_, variances) = objective.evaluate_parts(at)?;
+            let share = 0.5 * (options.stderr * best.abs().max(f64::MIN_POSITIVE)).powi(2);
+            let mut grew = false;
+            if variances.iter().sum::<f64>() > 2.0 * share {
+                for (count, variance) in counts.iter_mut().zip(variances) {
+                    if variance > share && *count < options.max_realizations {
+                        let factor = (variance / share).ceil() as usize;
+                        *count = (*count * factor.max(2)).min(options.max_realizations);
+                        grew = true;
+                    }
+                }
+            }
+            if !grew {
                 objective.evaluations.store(0, Ordering::Relaxed);
                 return Ok(objective);
             }
-            let factor = (relative / options.stderr).powi(2).ceil() as usize;
-            realizations = (realizations * factor.max(2)).min(options.max_realizations);
         }
     }
 
@@ -264,12 +294,13 @@ impl<'a> ShearObjective<'a> {
     ) -> Result<(), OptimizeError> {
         let n = self.n as f64;
         let exact_xy = xy_half.pair_spectrum();
-        let axes = |h: usize| exact_xy.map(|_| (4 * self.n).max(h));
+        let points = self.n;
+        let axes = |h: usize| exact_xy.map(|_| (4 * points).max(h));
         let first_half = match self.xy {
             XyPower::Exact => 64,
             XyPower::Empirical { freqs, .. } => freqs.half,
         };
-        self.terms = self.make_terms(light, exact_xy, &half_plane(first_half, axes(first_half)));
+        self.set_terms(light, exact_xy, &half_plane(first_half, axes(first_half)));
         self.half = first_half;
         let reference = starts
             .iter()
@@ -342,7 +373,7 @@ impl<'a> ShearObjective<'a> {
             .filter(|(_, k)| **k)
             .map(|(f, _)| *f)
             .collect();
-        self.terms = self.make_terms(light, exact_xy, &kept);
+        self.set_terms(light, exact_xy, &kept);
         self.half = half;
         self.truncation_bound = tail + dropped;
         Ok(())
@@ -357,16 +388,20 @@ impl<'a> ShearObjective<'a> {
         }
     }
 
-    /// The terms of the frequencies `ks`.
-    fn make_terms(
-        &self,
+    /// Sums over the frequencies `ks` (of the half-plane k_x ≥ 0), in the
+    /// order of (k_x, k_y).
+    fn set_terms(
+        &mut self,
         light: &dyn LightField,
         exact: Option<&dyn PairSpectrum>,
         ks: &[[i64; 2]],
-    ) -> Vec<Term> {
+    ) {
+        let mut ks = ks.to_vec();
+        ks.sort_unstable();
         let n = self.n as f64;
         let scale = 2.0 / (n * n * (n - 1.0));
-        ks.par_iter()
+        self.terms = ks
+            .par_iter()
             .map(|&k| {
                 let mut waves = Vec::new();
                 light.plane_waves(k, &mut waves);
@@ -381,17 +416,52 @@ impl<'a> ShearObjective<'a> {
                     box_index,
                 }
             })
-            .collect()
+            .collect();
+        let amplitudes = self
+            .terms
+            .iter()
+            .flat_map(|t| t.waves.iter().map(|w| w.amplitude))
+            .collect();
+        self.layer_sums = LayerSums::new(&ks, amplitudes, light.wave_slopes());
+        if let UvPairs::Empirical(uv) = &self.uv {
+            let diagonals: Vec<Vec<f64>> = uv
+                .sets
+                .par_iter()
+                .map_init(Scratch::default, |scratch, set| {
+                    let mut d = vec![0.0; self.terms.len()];
+                    self.layer_sums.diagonals(set, scratch, &mut d);
+                    d
+                })
+                .collect();
+            let weighted = diagonals
+                .iter()
+                .map(|d| crate::sum::sum(self.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)))
+                .collect();
+            let r = diagonals.len() as f64;
+            let mean_diagonal = (0..self.terms.len())
+                .map(|i| crate::sum::sum(diagonals.iter().map(|d| d[i])) / r)
+                .collect();
+            if let UvPairs::Empirical(uv) = &mut self.uv {
+                uv.weighted_diagonal = weighted;
+                uv.mean_diagonal = mean_diagonal;
+            }
+        }
     }
 
     /// J(a, b).
     pub fn value(&self, a: f64, b: f64) -> f64 {
         self.evaluations.fetch_add(1, Ordering::Relaxed);
+        let base = self.variance / self.n as f64;
+        let uv = match &self.uv {
+            UvPairs::Empirical(uv) => {
+                return base + mean(&self.per_realization(uv, [a, b]));
+            }
+            UvPairs::Exact(uv) => *uv,
+        };
         let partial: Vec<NeumaierSum> = self
             .terms
             .par_chunks(CHUNK)
             .map(|chunk| {
-                let uv = self.uv.spectrum();
                 let mut s = NeumaierSum::default();
                 for t in chunk {
                     s.add(t.coefficient * uv.wave_pair_sum(&t.waves, [a * t.k[0], b * t.k[1]]));
@@ -400,11 +470,59 @@ impl<'a> ShearObjective<'a> {
             })
             .collect();
         let mut total = NeumaierSum::default();
-        total.add(self.variance / self.n as f64);
+        total.add(base);
         for p in partial {
             total.merge(p);
         }
         total.value()
+    }
+
+    /// J − Var f/N on each realization of the (u, v) half (the (x, y) half
+    /// at its mean), computed per realization so the result is the same
+    /// for any number of threads.
+    fn per_realization(&self, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
+        uv.sets
+            .par_iter()
+            .zip(&uv.weighted_diagonal)
+            .map_init(
+                || (Scratch::default(), vec![0.0; self.terms.len()]),
+                |(scratch, sums), (set, diagonal)| {
+                    self.layer_sums.power_sums(set, shear, scratch, sums);
+                    let power = self
+                        .terms
+                        .iter()
+                        .zip(sums.iter())
+                        .map(|(t, p)| t.coefficient * p);
+                    crate::sum::sum(power.chain([-diagonal]))
+                },
+            )
+            .collect()
+    }
+
+    /// The mean over the (u, v) realizations of each term's pair sum.
+    fn mean_pair_sums(&self, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
+        let terms = self.terms.len();
+        let partial: Vec<Vec<f64>> = uv
+            .sets
+            .par_chunks(CHUNK)
+            .map(|chunk| {
+                let mut scratch = Scratch::default();
+                let mut sums = vec![0.0; terms];
+                let mut total = vec![0.0; terms];
+                for set in chunk {
+                    self.layer_sums
+                        .power_sums(set, shear, &mut scratch, &mut sums);
+                    for (t, s) in total.iter_mut().zip(&sums) {
+                        *t += s;
+                    }
+                }
+                total
+            })
+            .collect();
+        let r = uv.sets.len() as f64;
+        (0..terms)
+            .map(|i| crate::sum::sum(partial.iter().map(|p| p[i])) / r - uv.mean_diagonal[i])
+            .collect()
     }
 
     /// J at `shear` with its standard error: for an estimated half, the
@@ -413,43 +531,46 @@ impl<'a> ShearObjective<'a> {
     ///
     /// # Errors
     /// Sampler errors while redrawing an estimated (x, y) half.
-    pub fn evaluate(&self, [a, b]: [f64; 2]) -> Result<Evaluation, OptimizeError> {
-        let value = self.value(a, b);
+    pub fn evaluate(&self, shear: [f64; 2]) -> Result<Evaluation, OptimizeError> {
+        let (value, [xy, uv]) = self.evaluate_parts(shear)?;
+        Ok(Evaluation {
+            value,
+            stderr: (xy + uv).sqrt(),
+        })
+    }
+
+    /// J at `shear` and the variances of its estimate from the (x, y) and
+    /// the (u, v) half (0 for an exact half).
+    fn evaluate_parts(&self, [a, b]: [f64; 2]) -> Result<(f64, [f64; 2]), OptimizeError> {
         let base = self.variance / self.n as f64;
-        let mut variance = 0.0;
-        if let UvPairs::Empirical(sets) = &self.uv {
-            let per_set: Vec<f64> = (0..sets.sets())
-                .into_par_iter()
-                .map(|r| {
-                    let mut s = NeumaierSum::default();
-                    s.add(base);
-                    for t in &self.terms {
-                        s.add(
-                            t.coefficient
-                                * sets.wave_pair_sum_of(r, &t.waves, [a * t.k[0], b * t.k[1]]),
-                        );
-                    }
-                    s.value()
-                })
-                .collect();
-            variance += sample_variance(&per_set) / per_set.len() as f64;
-        }
+        let mut variances = [0.0; 2];
+        let value = match &self.uv {
+            UvPairs::Empirical(uv) => {
+                self.evaluations.fetch_add(1, Ordering::Relaxed);
+                let per_set = self.per_realization(uv, [a, b]);
+                variances[1] = sample_variance(&per_set) / per_set.len() as f64;
+                base + mean(&per_set)
+            }
+            UvPairs::Exact(_) => self.value(a, b),
+        };
         if let XyPower::Empirical { freqs, sets, .. } = &self.xy {
             let n = self.n as f64;
             let scale = 2.0 / (n * n * (n - 1.0));
+            let uv_sums: Vec<f64> = match &self.uv {
+                UvPairs::Empirical(uv) => self.mean_pair_sums(uv, [a, b]),
+                UvPairs::Exact(uv) => self
+                    .terms
+                    .iter()
+                    .map(|t| uv.wave_pair_sum(&t.waves, [a * t.k[0], b * t.k[1]]))
+                    .collect(),
+            };
             let uv_part: Vec<(usize, f64)> = self
                 .terms
                 .iter()
-                .map(|t| {
+                .zip(uv_sums)
+                .map(|(t, sum)| {
                     let index = t.box_index.expect("empirical terms index the box");
-                    (
-                        index,
-                        scale
-                            * self
-                                .uv
-                                .spectrum()
-                                .wave_pair_sum(&t.waves, [a * t.k[0], b * t.k[1]]),
-                    )
+                    (index, scale * sum)
                 })
                 .collect();
             let seed = self.seed ^ XY_STREAM;
@@ -474,12 +595,9 @@ impl<'a> ShearObjective<'a> {
                 &statistic,
                 &|| {},
             )?;
-            variance += sample_variance(&per_set) / per_set.len() as f64;
+            variances[0] = sample_variance(&per_set) / per_set.len() as f64;
         }
-        Ok(Evaluation {
-            value,
-            stderr: variance.sqrt(),
-        })
+        Ok((value, variances))
     }
 
     /// Bound on the error of J from the frequencies left out (assuming
@@ -506,7 +624,7 @@ impl<'a> ShearObjective<'a> {
         };
         let uv = match &self.uv {
             UvPairs::Exact(_) => 0,
-            UvPairs::Empirical(e) => e.sets(),
+            UvPairs::Empirical(uv) => uv.sets.len(),
         };
         [xy, uv]
     }
@@ -546,11 +664,7 @@ fn box_index(freqs: &FrequencyBox, k: [i64; 2]) -> usize {
 }
 
 /// Realizations 0..count of `sampler` from `seed`.
-fn draw(
-    sampler: &dyn Sampler,
-    seed: u64,
-    count: usize,
-) -> Result<Vec<crate::points::PointSet>, OptimizeError> {
+fn draw(sampler: &dyn Sampler, seed: u64, count: usize) -> Result<Vec<PointSet>, OptimizeError> {
     (0..count as u64)
         .into_par_iter()
         .map(|r| {
@@ -561,11 +675,16 @@ fn draw(
         .collect()
 }
 
+/// Mean of `values` (compensated).
+fn mean(values: &[f64]) -> f64 {
+    crate::sum::sum(values.iter().copied()) / values.len() as f64
+}
+
 /// Unbiased sample variance (two passes).
 fn sample_variance(values: &[f64]) -> f64 {
     if values.len() < 2 {
         return 0.0;
     }
-    let mean = crate::sum::sum(values.iter().copied()) / values.len() as f64;
-    crate::sum::sum(values.iter().map(|v| (v - mean) * (v - mean))) / (values.len() - 1) as f64
+    let m = mean(values);
+    crate::sum::sum(values.iter().map(|v| (v - m) * (v - m))) / (values.len() - 1) as f64
 }
