@@ -1071,3 +1071,34 @@ fn bench_samplers_lists_each_sampler_at_the_sizes_it_makes() {
         ns.is_finite() && ns > 0.0
     }));
 }
+
+/// `bench shear --quick`: the shear objective's pair sums by powers of one
+/// phasor per point agree with the direct sums (a sine and cosine per
+/// point, wave and term) to rounding, in units of the bound N(N − 1)(Σ|A|)²
+/// per realization: the products' phase error is ~k·ε at |k| ≤ 32.
+#[test]
+fn bench_shear_powers_agree_with_the_direct_sums() {
+    let dir = temp_dir("bench-shear");
+    let path = dir.join("shear.csv");
+    let run = varspec(&["bench", "shear", "--quick", "--csv", path.to_str().unwrap()]);
+    assert!(run.status.success(), "{run:?}");
+    let (header, rows) = csv_table(&path);
+    assert_eq!(
+        header,
+        [
+            "case",
+            "method",
+            "terms",
+            "seconds",
+            "max_rel_error",
+            "threads"
+        ]
+    );
+    // Two light fields at N = 64 and 256, direct and powers each.
+    assert_eq!(rows.len(), 8);
+    for r in rows.iter().filter(|r| r[1] == *"powers") {
+        let error: f64 = r[4].parse().unwrap();
+        assert!(error <= 1e-13, "{}: {error:e}", &r[0]);
+    }
+    assert_eq!(rows.iter().filter(|r| r[1] == *"direct").count(), 4);
+}

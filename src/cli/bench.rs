@@ -29,6 +29,19 @@ pub enum BenchCommand {
     /// Samplers: nanoseconds per coordinate drawn, one thread, at N = 16,
     /// 256 and 4096 in 2D and 4D.
     Samplers(SamplersArgs),
+    /// Shear objective with an estimated (u, v) half: pair sums by powers
+    /// of one phasor per point against the direct sums, time and error.
+    Shear(ShearArgs),
+}
+
+#[derive(clap::Args)]
+pub struct ShearArgs {
+    /// CSV of the table.
+    #[arg(long, default_value = "out/bench/bench-shear.csv")]
+    csv: PathBuf,
+    /// Skip N = 1024.
+    #[arg(long)]
+    quick: bool,
 }
 
 #[derive(clap::Args)]
@@ -88,6 +101,7 @@ pub fn run(c: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Predict(a) => &a.csv,
         BenchCommand::Render(a) => &a.csv,
         BenchCommand::Samplers(a) => &a.csv,
+        BenchCommand::Shear(a) => &a.csv,
     };
     prepare(csv)?;
     match c {
@@ -95,6 +109,7 @@ pub fn run(c: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Predict(a) => predict(a),
         BenchCommand::Render(a) => render(a),
         BenchCommand::Samplers(a) => samplers(a),
+        BenchCommand::Shear(a) => shear(a),
     }
 }
 
@@ -162,6 +177,125 @@ fn samplers(a: SamplersArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, rows.iter()))?;
+    println!("wrote {}", a.csv.display());
+    Ok(())
+}
+
+/// One evaluation of the shear objective's (u, v) pair sums (docs/mathematics.md
+/// §6.2): every term of the box |k|∞ ≤ 32 on 16 Poisson-disk realizations,
+/// by the direct sums (a sine and cosine per point, wave and term) and by
+/// powers of one phasor per point and axis; the error is the largest
+/// difference over the terms in units of the bound N(N − 1)(Σ_t|A_t|)².
+fn shear(a: ShearArgs) -> anyhow::Result<()> {
+    use rayon::prelude::*;
+    use varspec::integrands::PlaneWave;
+    use varspec::optimize::shear::LayerSums;
+    use varspec::spectrum::pair::EmpiricalPairs;
+
+    #[derive(serde::Serialize)]
+    struct Row {
+        case: String,
+        method: &'static str,
+        terms: usize,
+        seconds: f64,
+        max_rel_error: f64,
+        threads: usize,
+    }
+    const HALF: i64 = 32;
+    const SETS: u64 = 16;
+    let shear = [-0.3, 0.2];
+    let threads = rayon::current_num_threads();
+    println!(
+        "shear objective, (u, v) pair sums of one evaluation: {SETS} Poisson-disk sets, |k| <= {HALF}, shear {shear:?}, {threads} threads"
+    );
+    println!(
+        "{:<52} {:<8} {:>7} {:>10} {:>12}",
+        "case", "method", "terms", "seconds", "max error"
+    );
+    let ks: Vec<[i64; 2]> = (0..=HALF)
+        .flat_map(|kx| (-HALF..=HALF).map(move |ky| [kx, ky]))
+        .filter(|k| k[0] > 0 || k[1] > 0)
+        .collect();
+    let ns: &[usize] = if a.quick {
+        &[64, 256]
+    } else {
+        &[64, 256, 1024]
+    };
+    let mut rows = Vec::new();
+    for spec in [
+        "defocus:shape=disk,size=0.3,c=0.4",
+        "layers:c1=0.5,c2=-0.2,size=0.3",
+    ] {
+        let f = integrands::parse(spec)?;
+        let light = f
+            .light_field()
+            .expect("defocus and layers are light fields");
+        for &n in ns {
+            let (sampler, n) = registry::build_nearest("poisson-disk", n, Some(2), &[])?;
+            let sets = (0..SETS)
+                .map(|r| sampler.sample(&mut set_rng(5, r)))
+                .collect::<Result<Vec<_>, _>>()?;
+            let waves: Vec<Vec<PlaneWave>> = ks
+                .iter()
+                .map(|&k| {
+                    let mut w = Vec::new();
+                    light.plane_waves(k, &mut w);
+                    w
+                })
+                .collect();
+            let pairs = EmpiricalPairs::new(sets.clone());
+            let (direct_seconds, direct) = time(1, || {
+                ks.par_iter()
+                    .zip(&waves)
+                    .map(|(k, w)| {
+                        let sigma = [shear[0] * k[0] as f64, shear[1] * k[1] as f64];
+                        (0..sets.len())
+                            .map(|r| pairs.wave_pair_sum_of(r, w, sigma))
+                            .sum::<f64>()
+                    })
+                    .collect::<Vec<f64>>()
+            });
+            let sums = LayerSums::for_light_field(light, &ks);
+            let (powers_seconds, powers) = time(3, || {
+                let per_set: Vec<Vec<f64>> = sets
+                    .par_iter()
+                    .map(|set| sums.pair_sums(set, shear))
+                    .collect();
+                (0..ks.len())
+                    .map(|i| per_set.iter().map(|p| p[i]).sum::<f64>())
+                    .collect::<Vec<f64>>()
+            });
+            let bound = |w: &[PlaneWave]| {
+                let a: f64 = w.iter().map(|w| w.amplitude.norm()).sum();
+                SETS as f64 * (n * (n - 1)) as f64 * a * a
+            };
+            let error = direct
+                .iter()
+                .zip(&powers)
+                .zip(&waves)
+                .map(|((d, p), w)| (d - p).abs() / bound(w).max(f64::MIN_POSITIVE))
+                .fold(0.0, f64::max);
+            let case = format!("{spec}, N={n}");
+            for (method, seconds, err) in [
+                ("direct", direct_seconds, 0.0),
+                ("powers", powers_seconds, error),
+            ] {
+                println!(
+                    "{case:<52} {method:<8} {:>7} {seconds:>10.4} {err:>12.2e}",
+                    ks.len()
+                );
+                rows.push(Row {
+                    case: case.clone(),
+                    method,
+                    terms: ks.len(),
+                    seconds,
+                    max_rel_error: err,
+                    threads,
+                });
+            }
+        }
+    }
+    write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
     println!("wrote {}", a.csv.display());
     Ok(())
 }

@@ -20,6 +20,7 @@
 
 use rustfft::num_complex::Complex64;
 
+use crate::integrands::LightField;
 use crate::points::PointSet;
 use crate::spectrum::pair::turn;
 
@@ -36,7 +37,7 @@ struct Run {
 
 /// The terms of a sheared layer stack: frequencies of the half-plane
 /// k_x ≥ 0 in runs of consecutive k_y, the waves' slopes and amplitudes.
-pub(super) struct LayerSums {
+pub struct LayerSums {
     runs: Vec<Run>,
     /// The table row of E^(k_x), for the k_x in use.
     e_rows: Vec<Option<usize>>,
@@ -127,6 +128,30 @@ impl LayerSums {
             slopes,
             amplitudes,
         }
+    }
+
+    /// The terms of light field `light` at the frequencies `ks` (k_x ≥ 0,
+    /// sorted by (k_x, k_y)).
+    ///
+    /// # Panics
+    /// If `ks` is not sorted with k_x ≥ 0.
+    pub fn for_light_field(light: &dyn LightField, ks: &[[i64; 2]]) -> Self {
+        let mut amplitudes = Vec::new();
+        for &k in ks {
+            light.wave_amplitudes(k, &mut amplitudes);
+        }
+        Self::new(ks, amplitudes, light.wave_slopes())
+    }
+
+    /// The pair sums Σ_(l≠m) ψ_k(q_l)·conj(ψ_k(q_m)) of every term on the
+    /// (u, v) set `set` at shear `shear`.
+    pub fn pair_sums(&self, set: &PointSet, shear: [f64; 2]) -> Vec<f64> {
+        let mut scratch = Scratch::default();
+        let mut power = vec![0.0; self.terms];
+        self.power_sums(set, shear, &mut scratch, &mut power);
+        let mut diagonal = vec![0.0; self.terms];
+        self.diagonals(set, &mut scratch, &mut diagonal);
+        power.iter().zip(&diagonal).map(|(p, d)| p - d).collect()
     }
 
     /// Writes |Σ_l ψ_k(q_l)|² on the (u, v) set `set` at shear (a, b) to

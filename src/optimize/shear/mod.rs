@@ -6,13 +6,14 @@
 //! the integrand's spectrum ([`start`]).
 //!
 //! The search: evaluate J at the spectral candidates and at (0, 0); refine
-//! a, then b, by scans around the best point at shrinking scales (0.1, 0.01,
-//! 0.001: a hairline spectrum has a basin narrower than a coarse grid step) and Brent's method in the last interval; polish (a, b)
+//! a, then b, by scans around the best point at shrinking scales (0.1 and
+//! 0.01: a hairline spectrum has a basin narrower than a coarse grid step)
+//! and Brent's method in the last interval; polish (a, b)
 //! jointly with Nelder–Mead (both from argmin). The result is never worse
 //! than no shear: if J(found) ≥ J(0, 0), the search returns (0, 0).
 
 pub mod checked;
-mod layer_sums;
+pub mod layer_sums;
 pub mod objective;
 pub mod start;
 
@@ -20,6 +21,7 @@ use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::brent::BrentOpt;
 use argmin::solver::neldermead::NelderMead;
 
+pub use layer_sums::LayerSums;
 pub use objective::{Evaluation, ObjectiveOptions, ShearObjective};
 pub use start::{PlaneDirections, SpectralStart, spectral_start};
 
