@@ -2,10 +2,13 @@
 //! sizes of N: the found shear beside the analytic one, the expected
 //! variance before, at the analytic shear and at the found shear, and the
 //! search time. Writes `shear-matrix.csv` and a markdown table to the folder
-//! given as the first argument (default `out/shear-matrix`).
+//! given as the first argument (default `out/shear-matrix`). The second
+//! argument is the padded sampler (default `umj`; another sampler's files
+//! are named after it), the third the sizes N (default `64,256,1024`).
 //!
 //! ```sh
 //! cargo run --release --example shear_matrix -- results/optimize-shear
+//! cargo run --release --example shear_matrix -- results/optimize-shear padded:xy=cmj,uv=poisson-disk 256
 //! ```
 
 use std::time::Instant;
@@ -15,9 +18,24 @@ use varspec::optimize::shear::{ObjectiveOptions, ShearObjective, search_shear, s
 use varspec::registry;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let out = std::env::args()
-        .nth(1)
-        .unwrap_or_else(|| "out/shear-matrix".into());
+    let mut args = std::env::args().skip(1);
+    let out = args.next().unwrap_or_else(|| "out/shear-matrix".into());
+    let sampler_name = args.next().unwrap_or_else(|| "umj".into());
+    let ns = match args.next() {
+        Some(list) => list
+            .split(',')
+            .map(str::parse)
+            .collect::<Result<Vec<usize>, _>>()?,
+        None => vec![64, 256, 1024],
+    };
+    let stem = if sampler_name == "umj" {
+        "shear-matrix".to_string()
+    } else {
+        format!(
+            "shear-matrix-{}",
+            sampler_name.replace([':', ',', '='], "-")
+        )
+    };
     std::fs::create_dir_all(&out)?;
     let mut specs = Vec::new();
     for shape in ["box", "disk", "gaussian"] {
@@ -34,7 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ] {
         specs.push(layers.into());
     }
-    let mut csv = csv::Writer::from_path(format!("{out}/shear-matrix.csv"))?;
+    let mut csv = csv::Writer::from_path(format!("{out}/{stem}.csv"))?;
     csv.write_record([
         "integrand",
         "n",
@@ -53,9 +71,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "| integrand | N | found (a, b) | analytic | found / analytic | found / unsheared | s |\n|---|---|---|---|---|---|---|\n",
     );
     for spec in &specs {
-        for n in [64, 256, 1024] {
+        for &n in &ns {
             let f = integrands::parse(spec)?;
-            let sampler = registry::build("umj", n, Some(4), &[])?;
+            let sampler = registry::build(&sampler_name, n, Some(4), &[])?;
             let start = Instant::now();
             let spectral = spectral_start(f.as_ref(), 64, 2.0);
             let mut starts = spectral.candidates();
@@ -103,6 +121,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     csv.flush()?;
-    std::fs::write(format!("{out}/shear-matrix.md"), table)?;
+    std::fs::write(format!("{out}/{stem}.md"), table)?;
     Ok(())
 }

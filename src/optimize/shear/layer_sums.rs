@@ -213,8 +213,10 @@ impl LayerSums {
     }
 
     /// Adds Σ_l e^(2πi (w_x·k_x·u_l + w_y·k_y·v_l)) for every term to the
-    /// scratch sums from position `offset`: the rows of E_l^(k_x) and
-    /// F_l^(k_y) in use (points innermost), then one dot product per term.
+    /// scratch sums from position `offset`: per block of points (the
+    /// whole set where its tables fit in [`TABLE_BYTES`]),
+    /// the rows of E_l^(k_x) and F_l^(k_y) in use (points innermost), then
+    /// one dot product per term.
     fn add_phasor_sums(&self, set: &PointSet, w: [f64; 2], scratch: &mut Scratch, offset: usize) {
         let Scratch {
             powers,
@@ -224,46 +226,55 @@ impl LayerSums {
         } = scratch;
         let kx_max = self.e_rows.len() - 1;
         let ky_max = (self.f_rows.len() - 1) / 2;
-        let n = set.len();
-        let rows = |table: &[Option<usize>]| table.iter().flatten().count() * n;
-        let Tables {
-            e_re,
-            e_im,
-            f_re,
-            f_im,
-        } = tables;
-        e_re.resize(rows(&self.e_rows), 0.0);
-        e_im.resize(rows(&self.e_rows), 0.0);
-        f_re.resize(rows(&self.f_rows), 0.0);
-        f_im.resize(rows(&self.f_rows), 0.0);
-        powers.each(set.coords(), 0, w[0], kx_max, |k, pr, pi| {
-            if let Some(row) = self.e_rows[k] {
-                e_re[row * n..(row + 1) * n].copy_from_slice(pr);
-                e_im[row * n..(row + 1) * n].copy_from_slice(pi);
-            }
-        });
-        // F^(−k) is the conjugate of F^k.
-        powers.each(set.coords(), 1, w[1], ky_max, |k, pr, pi| {
-            if let Some(row) = self.f_rows[ky_max + k] {
-                f_re[row * n..(row + 1) * n].copy_from_slice(pr);
-                f_im[row * n..(row + 1) * n].copy_from_slice(pi);
-            }
-            if let Some(row) = self.f_rows[ky_max - k].filter(|_| k > 0) {
-                f_re[row * n..(row + 1) * n].copy_from_slice(pr);
-                for (o, v) in f_im[row * n..(row + 1) * n].iter_mut().zip(pi) {
-                    *o = -v;
-                }
-            }
-        });
         let re = &mut re[offset..offset + self.terms];
         let im = &mut im[offset..offset + self.terms];
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor supports AVX2, checked just above.
-            unsafe { self.add_dots_avx2(tables, n, re, im) };
-            return;
+        for block in set.coords().chunks(2 * self.points_per_block()) {
+            let n = block.len() / 2;
+            let rows = |table: &[Option<usize>]| table.iter().flatten().count() * n;
+            let Tables {
+                e_re,
+                e_im,
+                f_re,
+                f_im,
+            } = tables;
+            e_re.resize(rows(&self.e_rows), 0.0);
+            e_im.resize(rows(&self.e_rows), 0.0);
+            f_re.resize(rows(&self.f_rows), 0.0);
+            f_im.resize(rows(&self.f_rows), 0.0);
+            powers.each(block, 0, w[0], kx_max, |k, pr, pi| {
+                if let Some(row) = self.e_rows[k] {
+                    e_re[row * n..(row + 1) * n].copy_from_slice(pr);
+                    e_im[row * n..(row + 1) * n].copy_from_slice(pi);
+                }
+            });
+            // F^(−k) is the conjugate of F^k.
+            powers.each(block, 1, w[1], ky_max, |k, pr, pi| {
+                if let Some(row) = self.f_rows[ky_max + k] {
+                    f_re[row * n..(row + 1) * n].copy_from_slice(pr);
+                    f_im[row * n..(row + 1) * n].copy_from_slice(pi);
+                }
+                if let Some(row) = self.f_rows[ky_max - k].filter(|_| k > 0) {
+                    f_re[row * n..(row + 1) * n].copy_from_slice(pr);
+                    for (o, v) in f_im[row * n..(row + 1) * n].iter_mut().zip(pi) {
+                        *o = -v;
+                    }
+                }
+            });
+            #[cfg(target_arch = "x86_64")]
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor supports AVX2, checked just above.
+                unsafe { self.add_dots_avx2(tables, n, re, im) };
+                continue;
+            }
+            self.add_dots(tables, n, re, im);
         }
-        self.add_dots(tables, n, re, im);
+    }
+
+    /// Points per block: as many as keep the tables within [`TABLE_BYTES`]
+    /// (16 bytes per row and point), at least [`MIN_BLOCK`].
+    fn points_per_block(&self) -> usize {
+        let rows = self.e_rows.iter().chain(&self.f_rows).flatten().count();
+        (TABLE_BYTES / (16 * rows.max(1))).max(MIN_BLOCK)
     }
 
     /// Adds E^(k_x)·F^(k_y) summed over the points to each term's sums.
@@ -293,7 +304,17 @@ impl LayerSums {
     }
 }
 
-/// The rows of E_l^(k_x) and of F_l^(k_y) in use, the points innermost.
+/// The tables' size per thread that sets the points per block: whole sets
+/// where they fit (N = 256 with |k|∞ ≤ 1024: 12.6 MB), else blocks of at
+/// least [`MIN_BLOCK`] points; with the axes out to 4N = 16384 (N = 4096)
+/// whole tables would take gigabytes.
+const TABLE_BYTES: usize = 16 << 20;
+/// The fewest points per block (50 MB of tables at 49,154 rows), enough
+/// for the dot products to amortize their per-term work.
+const MIN_BLOCK: usize = 64;
+
+/// The rows of E_l^(k_x) and of F_l^(k_y) in use over one block of points,
+/// the points innermost.
 #[derive(Default)]
 struct Tables {
     e_re: Vec<f64>,
@@ -384,7 +405,8 @@ mod tests {
 
     /// The table equals the direct sum (one sine and cosine per point, wave
     /// and frequency) of `EmpiricalPairs`, including frequencies out to
-    /// 1024 on the axes, where the powers' rounding is largest.
+    /// 6000 on the axes, where the powers' rounding is largest and the
+    /// points are summed in blocks.
     #[test]
     fn layer_sums_equal_direct_sums() {
         let mut rng = set_rng(7, 0);
@@ -401,11 +423,15 @@ mod tests {
             }
         }
         ks.extend([[0, 1024], [300, 0], [1024, 0]]);
+        // Axes out to 6000 take the tables past TABLE_BYTES: the 97
+        // points are summed in two blocks.
+        ks.extend((1025..=6000).flat_map(|k| [[k, 0], [0, k], [0, -k]]));
         ks.sort();
         let amplitudes: Vec<Complex64> = (0..ks.len() * slopes.len())
             .map(|_| Complex64::new(uniform(&mut rng) - 0.5, uniform(&mut rng) - 0.5))
             .collect();
         let sums = LayerSums::new(&ks, amplitudes.clone(), slopes.clone());
+        assert!(sums.points_per_block() < 97, "{}", sums.points_per_block());
         let direct = EmpiricalPairs::new(vec![set.clone()]);
         let shear = [-0.37, 1.21];
         let mut scratch = Scratch::default();
