@@ -628,7 +628,10 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
         min_realizations: a.realizations.max(2),
         ..PixelShearOptions::default()
     };
-    let found = search_pixel_shear(&f, sampler.as_ref(), options)?;
+    let spinner = progress::spinner("searching the pixel's shear");
+    let found = search_pixel_shear(&f, sampler.as_ref(), options);
+    spinner.finish_and_clear();
+    let found = found?;
     let seconds = start.elapsed().as_secs_f64();
     let best = found.best();
     sheared_outputs(&a, &f.spec(), sampler.as_ref(), |s| {
@@ -754,6 +757,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         Some(bytes),
         "lower --sets or --realizations",
     )?;
+    let spinner = progress::spinner("searching the shear");
     let run = search_and_check(
         f.as_ref(),
         sampler.as_ref(),
@@ -761,7 +765,9 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         a.seed,
         a.range,
         a.realizations,
-    )?;
+    );
+    spinner.finish_and_clear();
+    let run = run?;
     let (found, check, search_seconds) = (&run.found, &run.check, run.search_seconds);
     sheared_outputs(&a, &f.spec(), sampler.as_ref(), |s| {
         Ok(shear_set(s, found.shear)?)
