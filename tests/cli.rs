@@ -1102,3 +1102,34 @@ fn bench_shear_powers_agree_with_the_direct_sums() {
     }
     assert_eq!(rows.iter().filter(|r| r[1] == *"direct").count(), 4);
 }
+
+/// The shear search with both halves estimated from realizations (the
+/// (x, y) power by NUFFT, the (u, v) pair sums by tables of powers) gives
+/// the same JSON on one and two threads, all but its wall time.
+#[test]
+fn estimated_shear_search_is_identical_on_one_and_two_threads() {
+    let args = [
+        "optimize",
+        "shear",
+        "--sampler",
+        "padded:xy=poisson-disk,uv=poisson-disk",
+        "-n",
+        "64",
+        "--integrand",
+        "layers:c1=0.5,c2=-0.2,size=0.3",
+        "--realizations",
+        "50",
+        "--json",
+    ];
+    let run = |threads| {
+        let out = varspec_with(&args, Some(threads));
+        assert!(out.status.success(), "{out:?}");
+        let mut json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        json.as_object_mut().unwrap().remove("seconds");
+        json
+    };
+    let one = run("1");
+    let estimated = |h: usize| one["objective"]["realizations"][h].as_u64().unwrap() > 0;
+    assert!(estimated(0) && estimated(1), "both halves estimated: {one}");
+    assert_eq!(one, run("2"));
+}
