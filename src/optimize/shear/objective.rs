@@ -45,8 +45,8 @@ use crate::spectrum::pair::PairSpectrum;
 use crate::spectrum::{FrequencyBox, Method, expected_power_with};
 use crate::sum::NeumaierSum;
 
-/// Terms summed per parallel task: fixed, so the sum's rounding is the
-/// same for any number of threads.
+/// Terms (or realizations) summed per parallel task: fixed, so the sum's
+/// rounding is the same for any number of threads.
 const CHUNK: usize = 32;
 /// Largest box half-width of the frequency sum.
 const MAX_HALF: usize = 1024;
@@ -254,16 +254,21 @@ impl<'a> ShearObjective<'a> {
                 .copied()
                 .find(|s| objective.value(s[0], s[1]) == best)
                 .unwrap_or([0.0, 0.0]);
-            // Each half gets half the target variance; a half over its
-            // share grows by the ratio (the variance falls as 1/R).
+            // Each estimated half gets an equal share of the target
+            // variance; a half over its share grows by the ratio (the
+            // variance falls as 1/R).
             let (_, variances) = objective.evaluate_parts(at)?;
-            let share = 0.5 * (options.stderr * best.abs().max(f64::MIN_POSITIVE)).powi(2);
+            let estimated = objective.realizations().iter().filter(|&&r| r > 0).count();
+            let target = (options.stderr * best.abs().max(f64::MIN_POSITIVE)).powi(2);
+            let share = target / estimated.max(1) as f64;
             let mut grew = false;
-            if variances.iter().sum::<f64>() > 2.0 * share {
+            if variances.iter().sum::<f64>() > target {
                 for (count, variance) in counts.iter_mut().zip(variances) {
                     if variance > share && *count < options.max_realizations {
-                        let factor = (variance / share).ceil() as usize;
-                        *count = (*count * factor.max(2)).min(options.max_realizations);
+                        // Clamped in f64: a vanishing share must not
+                        // overflow the count.
+                        let factor = (variance / share).ceil().clamp(2.0, 1e6) as usize;
+                        *count = count.saturating_mul(factor).min(options.max_realizations);
                         grew = true;
                     }
                 }
@@ -424,22 +429,36 @@ impl<'a> ShearObjective<'a> {
             .collect();
         self.layer_sums = LayerSums::new(&ks, amplitudes, light.wave_slopes());
         if let UvPairs::Empirical(uv) = &self.uv {
-            let diagonals: Vec<Vec<f64>> = uv
+            // Per chunk of sets: each set's weighted diagonal and the
+            // chunk's sum of diagonals (memory: chunks × terms, not sets ×
+            // terms).
+            let terms = self.terms.len();
+            let partial: Vec<(Vec<f64>, Vec<f64>)> = uv
                 .sets
-                .par_iter()
-                .map_init(Scratch::default, |scratch, set| {
-                    let mut d = vec![0.0; self.terms.len()];
-                    self.layer_sums.diagonals(set, scratch, &mut d);
-                    d
+                .par_chunks(CHUNK)
+                .map(|chunk| {
+                    let mut scratch = Scratch::default();
+                    let mut d = vec![0.0; terms];
+                    let mut total = vec![0.0; terms];
+                    let mut weighted = Vec::with_capacity(chunk.len());
+                    for set in chunk {
+                        self.layer_sums.diagonals(set, &mut scratch, &mut d);
+                        let w = self.terms.iter().zip(&d).map(|(t, d)| t.coefficient * d);
+                        weighted.push(crate::sum::sum(w));
+                        for (t, x) in total.iter_mut().zip(&d) {
+                            *t += x;
+                        }
+                    }
+                    (weighted, total)
                 })
                 .collect();
-            let weighted = diagonals
+            let weighted: Vec<f64> = partial
                 .iter()
-                .map(|d| crate::sum::sum(self.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)))
+                .flat_map(|(w, _)| w.iter().copied())
                 .collect();
-            let r = diagonals.len() as f64;
-            let mean_diagonal = (0..self.terms.len())
-                .map(|i| crate::sum::sum(diagonals.iter().map(|d| d[i])) / r)
+            let r = uv.sets.len() as f64;
+            let mean_diagonal = (0..terms)
+                .map(|i| crate::sum::sum(partial.iter().map(|(_, t)| t[i])) / r)
                 .collect();
             if let UvPairs::Empirical(uv) = &mut self.uv {
                 uv.weighted_diagonal = weighted;
