@@ -429,37 +429,13 @@ impl<'a> ShearObjective<'a> {
             .collect();
         self.layer_sums = LayerSums::new(&ks, amplitudes, light.wave_slopes());
         if let UvPairs::Empirical(uv) = &self.uv {
-            // Per chunk of sets: each set's weighted diagonal and the
-            // chunk's sum of diagonals (memory: chunks × terms, not sets ×
-            // terms).
-            let terms = self.terms.len();
-            let partial: Vec<(Vec<f64>, Vec<f64>)> = uv
-                .sets
-                .par_chunks(CHUNK)
-                .map(|chunk| {
-                    let mut scratch = Scratch::default();
-                    let mut d = vec![0.0; terms];
-                    let mut total = vec![0.0; terms];
-                    let mut weighted = Vec::with_capacity(chunk.len());
-                    for set in chunk {
-                        self.layer_sums.diagonals(set, &mut scratch, &mut d);
-                        let w = self.terms.iter().zip(&d).map(|(t, d)| t.coefficient * d);
-                        weighted.push(crate::sum::sum(w));
-                        for (t, x) in total.iter_mut().zip(&d) {
-                            *t += x;
-                        }
-                    }
-                    (weighted, total)
-                })
-                .collect();
-            let weighted: Vec<f64> = partial
-                .iter()
-                .flat_map(|(w, _)| w.iter().copied())
-                .collect();
+            let (weighted, total) = self.sum_over_sets(
+                &uv.sets,
+                |set, scratch, d| self.layer_sums.diagonals(set, scratch, d),
+                |d| crate::sum::sum(self.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)),
+            );
             let r = uv.sets.len() as f64;
-            let mean_diagonal = (0..terms)
-                .map(|i| crate::sum::sum(partial.iter().map(|(_, t)| t[i])) / r)
-                .collect();
+            let mean_diagonal = total.iter().map(|t| t / r).collect();
             if let UvPairs::Empirical(uv) = &mut self.uv {
                 uv.weighted_diagonal = weighted;
                 uv.mean_diagonal = mean_diagonal;
@@ -520,28 +496,55 @@ impl<'a> ShearObjective<'a> {
 
     /// The mean over the (u, v) realizations of each term's pair sum.
     fn mean_pair_sums(&self, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
+        let (_, total) = self.sum_over_sets(
+            &uv.sets,
+            |set, scratch, sums| self.layer_sums.power_sums(set, shear, scratch, sums),
+            |_| 0.0,
+        );
+        let r = uv.sets.len() as f64;
+        total
+            .iter()
+            .zip(&uv.mean_diagonal)
+            .map(|(t, d)| t / r - d)
+            .collect()
+    }
+
+    /// The per-term vectors `fill` writes for each of `sets`, summed over
+    /// the sets, and `scalar` of each set's vector, in fixed chunks of
+    /// [`CHUNK`] sets (memory: chunks × terms, not sets × terms; the same
+    /// sums for any number of threads).
+    fn sum_over_sets(
+        &self,
+        sets: &[PointSet],
+        fill: impl Fn(&PointSet, &mut Scratch, &mut [f64]) + Sync,
+        scalar: impl Fn(&[f64]) -> f64 + Sync,
+    ) -> (Vec<f64>, Vec<f64>) {
         let terms = self.terms.len();
-        let partial: Vec<Vec<f64>> = uv
-            .sets
+        let partial: Vec<(Vec<f64>, Vec<f64>)> = sets
             .par_chunks(CHUNK)
             .map(|chunk| {
                 let mut scratch = Scratch::default();
-                let mut sums = vec![0.0; terms];
+                let mut v = vec![0.0; terms];
                 let mut total = vec![0.0; terms];
+                let mut scalars = Vec::with_capacity(chunk.len());
                 for set in chunk {
-                    self.layer_sums
-                        .power_sums(set, shear, &mut scratch, &mut sums);
-                    for (t, s) in total.iter_mut().zip(&sums) {
-                        *t += s;
+                    fill(set, &mut scratch, &mut v);
+                    scalars.push(scalar(&v));
+                    for (t, x) in total.iter_mut().zip(&v) {
+                        *t += x;
                     }
                 }
-                total
+                (scalars, total)
             })
             .collect();
-        let r = uv.sets.len() as f64;
-        (0..terms)
-            .map(|i| crate::sum::sum(partial.iter().map(|p| p[i])) / r - uv.mean_diagonal[i])
-            .collect()
+        let scalars = partial
+            .iter()
+            .flat_map(|(s, _)| s.iter().copied())
+            .collect();
+        let total = (0..terms)
+            .map(|i| crate::sum::sum(partial.iter().map(|(_, t)| t[i])))
+            .collect();
+        (scalars, total)
     }
 
     /// J at `shear` with its standard error: for an estimated half, the
