@@ -226,6 +226,87 @@ fn estimated_halves_report_their_standard_error() {
 }
 
 #[test]
+fn estimated_objective_matches_brute_force_variances() {
+    // Halves without a closed form: J is estimated from the sampler's own
+    // realizations (the (u, v) half's pair sums by powers of one phasor,
+    // the (x, y) half's power on a box), end to end against variances that
+    // only evaluate f on fresh sheared sets.
+    for (spec, sampler, n, shears) in [
+        (
+            "defocus:shape=disk,size=0.3,c=0.4",
+            "padded:xy=cmj,uv=poisson-disk",
+            64,
+            vec![[0.0, 0.0], [-0.4, -0.4], [-0.25, 0.3]],
+        ),
+        (
+            "layers:shape=gaussian,size=0.35,c1=-0.45,c2=0.25,mix=0.6",
+            "padded:xy=poisson-disk,uv=jitter",
+            49,
+            vec![[0.0, 0.0], [0.45, 0.45], [-0.25, -0.25]],
+        ),
+    ] {
+        let f = integrands::parse(spec).unwrap();
+        let s = registry::build(sampler, n, Some(4), &[]).unwrap();
+        let (objective, _) = objective(f.as_ref(), s.as_ref());
+        for shear in shears {
+            let j = objective.evaluate(shear).unwrap();
+            let (v, se) = brute_force(f.as_ref(), s.as_ref(), shear, 20_000);
+            assert!(
+                objective.truncation_bound() <= 0.05 * v,
+                "{spec} {sampler}: truncation bound {:e} against variance {v:e}",
+                objective.truncation_bound()
+            );
+            let sigma = se.hypot(j.stderr);
+            let tolerance = Z * sigma + objective.truncation_bound();
+            assert!(
+                (j.value - v).abs() <= tolerance,
+                "{spec} {sampler} N={n} shear {shear:?}: estimated {:e} ± {:e} vs brute force \
+                 {v:e} ± {se:e}; allowed {tolerance:e} ({Z}σ of both + truncation bound {:e})",
+                j.value,
+                j.stderr,
+                objective.truncation_bound()
+            );
+        }
+    }
+}
+
+#[test]
+fn the_coarse_objective_has_the_basin_of_the_full_one() {
+    // The search scans the coarse J (the 2048 largest-bound terms) to
+    // locate basins: on apertures with edges at N = 1024, where it drops
+    // most terms, its minimum along each axis is the light
+    // field's shear, as J's is.
+    for spec in [
+        "defocus:shape=disk,size=0.3,c=0.62",
+        "defocus:shape=box,size=0.15,c=-0.37",
+    ] {
+        let f = integrands::parse(spec).unwrap();
+        let c = f.light_field().unwrap().layer_shears()[0][0];
+        let s = registry::build("padded:xy=cmj,uv=jitter", 1024, Some(4), &[]).unwrap();
+        let (objective, _) = objective(f.as_ref(), s.as_ref());
+        assert!(
+            objective.coarse_terms() < objective.terms() / 10,
+            "{spec}: coarse {} of {} terms",
+            objective.coarse_terms(),
+            objective.terms()
+        );
+        let grid: Vec<f64> = (-20..=20).map(|i| 0.1 * i as f64).collect();
+        let argmin = |values: Vec<f64>| {
+            let i = (0..values.len())
+                .min_by(|&i, &j| values[i].total_cmp(&values[j]))
+                .unwrap();
+            grid[i]
+        };
+        let coarse = argmin(grid.iter().map(|&a| objective.coarse_value(a, c)).collect());
+        let full = argmin(grid.iter().map(|&a| objective.value(a, c)).collect());
+        assert!(
+            (coarse - c).abs() <= 0.05 + 1e-12 && (full - c).abs() <= 0.05 + 1e-12,
+            "{spec}: coarse J's grid minimum at {coarse}, J's at {full}, light field's shear {c}"
+        );
+    }
+}
+
+#[test]
 fn integrands_and_samplers_without_the_structure_are_refused() {
     let umj = registry::build("umj", 16, Some(4), &[]).unwrap();
     let sobol = registry::build("sobol", 16, Some(4), &[]).unwrap();

@@ -37,6 +37,7 @@ struct Run {
 
 /// The terms of a sheared layer stack: frequencies of the half-plane
 /// k_x ≥ 0 in runs of consecutive k_y, the waves' slopes and amplitudes.
+#[derive(Default)]
 pub struct LayerSums {
     runs: Vec<Run>,
     /// The table row of E^(k_x), for the k_x in use.

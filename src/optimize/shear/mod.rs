@@ -6,9 +6,11 @@
 //! the integrand's spectrum ([`start`]).
 //!
 //! The search: evaluate J at the spectral candidates and at (0, 0); refine
-//! a, then b, by scans around the best point at shrinking scales (0.1 and
-//! 0.01: a hairline spectrum has a basin narrower than a coarse grid step)
-//! and Brent's method in the last interval; polish (a, b)
+//! a, then b, by scans at shrinking scales: 0.1 over the whole range on a
+//! coarse J (the low frequencies, whose basins are wide; J itself then
+//! ranks its deepest local minima), 0.01 around the best on J (a hairline
+//! spectrum has a basin narrower than a coarse grid step), and Brent's
+//! method in the last interval; polish (a, b)
 //! jointly with Nelder–Mead (both from argmin). The result is never worse
 //! than no shear: if J(found) ≥ J(0, 0), the search returns (0, 0).
 
@@ -36,6 +38,9 @@ pub const SENSITIVITY_STEP: f64 = 0.01;
 const COARSE_STEP: f64 = 0.1;
 /// Points on each side of the current value in one refinement scan.
 const SCAN_POINTS: i32 = 10;
+/// Local minima of the coarse scan that J compares (a double wedge has
+/// two, one per layer; the coarse J may rank them differently from J).
+const BASINS: usize = 3;
 
 /// The search result.
 #[derive(Debug, Clone)]
@@ -55,6 +60,8 @@ pub struct ShearResult {
     pub kept_unsheared: bool,
     /// Objective evaluations.
     pub evaluations: u64,
+    /// Evaluations of the coarse objective (the scans that locate basins).
+    pub coarse_evaluations: u64,
 }
 
 /// J along one coordinate, the other held fixed, for Brent's method.
@@ -65,12 +72,22 @@ struct Line<'o, 'a> {
 }
 
 impl Line<'_, '_> {
-    fn at(&self, t: f64) -> f64 {
+    fn shear(&self, t: f64) -> [f64; 2] {
         if self.along_a {
-            self.objective.value(t, self.fixed)
+            [t, self.fixed]
         } else {
-            self.objective.value(self.fixed, t)
+            [self.fixed, t]
         }
+    }
+
+    fn at(&self, t: f64) -> f64 {
+        let [a, b] = self.shear(t);
+        self.objective.value(a, b)
+    }
+
+    fn coarse_at(&self, t: f64) -> f64 {
+        let [a, b] = self.shear(t);
+        self.objective.coarse_value(a, b)
     }
 }
 
@@ -137,6 +154,7 @@ pub fn search_shear(
         let (t, _) = refine_line(&line, shear[axis], range)?;
         shear[axis] = t;
     }
+    let lined = objective.value(shear[0], shear[1]);
     let step = 0.05 * SENSITIVITY_STEP;
     let simplex = vec![
         shear.to_vec(),
@@ -144,7 +162,8 @@ pub fn search_shear(
         vec![shear[0], shear[1] + step],
     ];
     let solver = NelderMead::new(simplex)
-        .with_sd_tolerance(1e-14)
+        // J to 1e-8 of itself: far below its truncation bound and stderr.
+        .with_sd_tolerance(1e-8 * lined)
         .map_err(|e| OptimizeError::Search(e.to_string()))?;
     let result = Executor::new(Joint(objective), solver)
         .configure(|s| s.max_iters(100))
@@ -152,7 +171,7 @@ pub fn search_shear(
         .map_err(|e| OptimizeError::Search(e.to_string()))?;
     if let Some(p) = result.state().get_best_param() {
         let polished = clamp([p[0], p[1]]);
-        if objective.value(polished[0], polished[1]) < objective.value(shear[0], shear[1]) {
+        if objective.value(polished[0], polished[1]) < lined {
             shear = polished;
         }
     }
@@ -177,17 +196,24 @@ pub fn search_shear(
         sensitivity,
         kept_unsheared,
         evaluations: objective.evaluations(),
+        coarse_evaluations: objective.coarse_evaluations(),
     })
 }
 
 /// Minimizes J along a line from `t0`: a scan of the whole range at step
-/// [`COARSE_STEP`], a scan of ±10 points around the best at step 0.01, then
-/// Brent's method within one step of the best.
+/// [`COARSE_STEP`] on the coarse J ([`ShearObjective::coarse_value`]), J
+/// at its [`BASINS`] deepest local minima, a scan of ±10 points around the
+/// best at step 0.01, then Brent's method within one step of the best.
 fn refine_line(line: &Line, t0: f64, range: f64) -> Result<(f64, f64), OptimizeError> {
     let mut best = (t0, line.at(t0));
     let coarse = (range / COARSE_STEP).ceil() as i32;
-    for i in -coarse..=coarse {
-        let t = (COARSE_STEP * i as f64).clamp(-range, range);
+    let scan: Vec<(f64, f64)> = (-coarse..=coarse)
+        .map(|i| {
+            let t = (COARSE_STEP * i as f64).clamp(-range, range);
+            (t, line.coarse_at(t))
+        })
+        .collect();
+    for t in deepest_minima(&scan, BASINS) {
         let v = line.at(t);
         if v < best.1 {
             best = (t, v);
@@ -224,6 +250,20 @@ fn refine_line(line: &Line, t0: f64, range: f64) -> Result<(f64, f64), OptimizeE
         }
     }
     Ok(best)
+}
+
+/// The arguments of the `count` deepest local minima of the scan
+/// `(t, value)` (ends compared with their one neighbour), deepest first.
+fn deepest_minima(scan: &[(f64, f64)], count: usize) -> Vec<f64> {
+    let mut minima: Vec<(f64, f64)> = (0..scan.len())
+        .filter(|&i| {
+            let v = scan[i].1;
+            (i == 0 || v <= scan[i - 1].1) && (i + 1 == scan.len() || v <= scan[i + 1].1)
+        })
+        .map(|i| scan[i])
+        .collect();
+    minima.sort_by(|x, y| x.1.total_cmp(&y.1).then(x.0.total_cmp(&y.0)));
+    minima.into_iter().take(count).map(|(t, _)| t).collect()
 }
 
 /// A 4D sampler whose sets come out sheared by (a, b).
@@ -283,4 +323,25 @@ pub fn shear_set(set: &PointSet, [a, b]: [f64; 2]) -> Result<PointSet, OptimizeE
         )));
     }
     Ok(shear_coords(set, [a, b]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::deepest_minima;
+
+    #[test]
+    fn local_minima_come_deepest_first_with_the_ends() {
+        let scan: Vec<(f64, f64)> = [1.0, 3.0, 2.0, 5.0, 0.5, 0.7, 4.0, 4.0, 6.0, 2.5]
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| (i as f64, v))
+            .collect();
+        assert_eq!(deepest_minima(&scan, 3), vec![4.0, 0.0, 2.0]);
+        // The shoulder at 7 (level with its left neighbour) counts.
+        assert_eq!(deepest_minima(&scan, 10), vec![4.0, 0.0, 2.0, 9.0, 7.0]);
+        // A plateau offers each of its points; ties go to the smaller t.
+        let flat = [(0.0, 1.0), (1.0, 1.0), (2.0, 1.0)];
+        assert_eq!(deepest_minima(&flat, 2), vec![0.0, 1.0]);
+        assert!(deepest_minima(&[], 3).is_empty());
+    }
 }

@@ -50,6 +50,10 @@ use crate::sum::NeumaierSum;
 const CHUNK: usize = 32;
 /// Largest box half-width of the frequency sum.
 const MAX_HALF: usize = 1024;
+/// Terms of the coarse J: enough for the low frequencies that set the
+/// basins (the box |k|∞ ≤ 32 holds 2,144), a fraction of the full sum's
+/// 12,500–156,000 at N = 256…4096 for an aperture with an edge.
+pub const COARSE_TERMS: usize = 2048;
 /// Box half-width when the (x, y) half is estimated from realizations.
 const EMPIRICAL_HALF: usize = 48;
 /// Stream offsets of the realizations behind empirical halves.
@@ -111,24 +115,22 @@ enum UvPairs<'a> {
     Empirical(UvRealizations),
 }
 
-/// Realizations of the (u, v) half and their diagonals Σ_l |ψ_k(q_l)|²,
-/// which no shear changes, for the current terms.
+/// Realizations of the (u, v) half.
 struct UvRealizations {
     sets: Vec<PointSet>,
-    /// Σ_k coefficient·diagonal, per realization.
-    weighted_diagonal: Vec<f64>,
-    /// The mean diagonal over the realizations, per term.
-    mean_diagonal: Vec<f64>,
 }
 
-impl UvRealizations {
-    fn new(sets: Vec<PointSet>) -> Self {
-        UvRealizations {
-            sets,
-            weighted_diagonal: Vec::new(),
-            mean_diagonal: Vec::new(),
-        }
-    }
+/// Frequencies summed in J, with what an estimated (u, v) half needs of
+/// them: their table of powers and their diagonals Σ_l |ψ_k(q_l)|², which
+/// no shear changes.
+#[derive(Default)]
+struct TermSet {
+    terms: Vec<Term>,
+    layer_sums: LayerSums,
+    /// Σ_k coefficient·diagonal, per (u, v) realization.
+    weighted_diagonal: Vec<f64>,
+    /// The mean diagonal over the (u, v) realizations, per term.
+    mean_diagonal: Vec<f64>,
 }
 
 /// The objective J(a, b): the expected variance of the (x, y)-shifted
@@ -139,13 +141,16 @@ pub struct ShearObjective<'a> {
     sampler: &'a dyn Sampler,
     xy: XyPower,
     uv: UvPairs<'a>,
-    terms: Vec<Term>,
-    /// The terms as a table of powers, for an estimated (u, v) half.
-    layer_sums: LayerSums,
+    /// The terms of J within its truncation bound.
+    full: TermSet,
+    /// The [`COARSE_TERMS`] of them with the largest bounds: J at low
+    /// resolution in the shear, for scans that locate basins.
+    coarse: TermSet,
     half: usize,
     truncation_bound: f64,
     seed: u64,
     evaluations: AtomicU64,
+    coarse_evaluations: AtomicU64,
 }
 
 /// J at one shear with its uncertainty.
@@ -198,11 +203,9 @@ impl<'a> ShearObjective<'a> {
             let [xy_count, uv_count] = counts;
             let uv = match uv_half.pair_spectrum() {
                 Some(s) => UvPairs::Exact(s),
-                None => UvPairs::Empirical(UvRealizations::new(draw(
-                    uv_half,
-                    options.seed ^ UV_STREAM,
-                    uv_count,
-                )?)),
+                None => UvPairs::Empirical(UvRealizations {
+                    sets: draw(uv_half, options.seed ^ UV_STREAM, uv_count)?,
+                }),
             };
             let xy = match xy_half.pair_spectrum() {
                 Some(_) => XyPower::Exact,
@@ -237,12 +240,13 @@ impl<'a> ShearObjective<'a> {
                 sampler,
                 xy,
                 uv,
-                terms: Vec::new(),
-                layer_sums: LayerSums::new(&[], Vec::new(), light.wave_slopes()),
+                full: TermSet::default(),
+                coarse: TermSet::default(),
                 half: 0,
                 truncation_bound: 0.0,
                 seed: options.seed,
                 evaluations: 0.into(),
+                coarse_evaluations: 0.into(),
             };
             objective.choose_terms(light, xy_half, starts, options.truncation)?;
             let best = starts
@@ -275,6 +279,7 @@ impl<'a> ShearObjective<'a> {
             }
             if !grew {
                 objective.evaluations.store(0, Ordering::Relaxed);
+                objective.coarse_evaluations.store(0, Ordering::Relaxed);
                 return Ok(objective);
             }
         }
@@ -289,7 +294,9 @@ impl<'a> ShearObjective<'a> {
     ///    exact (x, y) halves the axes out to 4N (stratified samplers keep
     ///    their 1D structure there, p ≈ 0 far out);
     /// 2. the terms with the smallest bounds |p − 1|·(Σ_t|A_t|)²·2/(N − 1)
-    ///    dropped while their sum stays within the remaining third.
+    ///    dropped while their sum stays within the remaining third;
+    /// 3. the [`COARSE_TERMS`] kept terms with the largest bounds make the
+    ///    coarse set.
     fn choose_terms(
         &mut self,
         light: &dyn LightField,
@@ -305,7 +312,7 @@ impl<'a> ShearObjective<'a> {
             XyPower::Exact => 64,
             XyPower::Empirical { freqs, .. } => freqs.half,
         };
-        self.set_terms(light, exact_xy, &half_plane(first_half, axes(first_half)));
+        self.full = self.term_set(light, exact_xy, &half_plane(first_half, axes(first_half)));
         self.half = first_half;
         let reference = starts
             .iter()
@@ -378,7 +385,15 @@ impl<'a> ShearObjective<'a> {
             .filter(|(_, k)| **k)
             .map(|(f, _)| *f)
             .collect();
-        self.set_terms(light, exact_xy, &kept);
+        let coarse: Vec<[i64; 2]> = order
+            .iter()
+            .rev()
+            .filter(|&&i| keep[i])
+            .take(COARSE_TERMS)
+            .map(|&i| frequencies[i])
+            .collect();
+        self.full = self.term_set(light, exact_xy, &kept);
+        self.coarse = self.term_set(light, exact_xy, &coarse);
         self.half = half;
         self.truncation_bound = tail + dropped;
         Ok(())
@@ -393,19 +408,19 @@ impl<'a> ShearObjective<'a> {
         }
     }
 
-    /// Sums over the frequencies `ks` (of the half-plane k_x ≥ 0), in the
-    /// order of (k_x, k_y).
-    fn set_terms(
-        &mut self,
+    /// The terms of the frequencies `ks` (of the half-plane k_x ≥ 0), in
+    /// the order of (k_x, k_y).
+    fn term_set(
+        &self,
         light: &dyn LightField,
         exact: Option<&dyn PairSpectrum>,
         ks: &[[i64; 2]],
-    ) {
+    ) -> TermSet {
         let mut ks = ks.to_vec();
         ks.sort_unstable();
         let n = self.n as f64;
         let scale = 2.0 / (n * n * (n - 1.0));
-        self.terms = ks
+        let terms: Vec<Term> = ks
             .par_iter()
             .map(|&k| {
                 let mut waves = Vec::new();
@@ -422,38 +437,56 @@ impl<'a> ShearObjective<'a> {
                 }
             })
             .collect();
-        let amplitudes = self
-            .terms
+        let amplitudes = terms
             .iter()
             .flat_map(|t| t.waves.iter().map(|w| w.amplitude))
             .collect();
-        self.layer_sums = LayerSums::new(&ks, amplitudes, light.wave_slopes());
+        let mut set = TermSet {
+            terms,
+            layer_sums: LayerSums::new(&ks, amplitudes, light.wave_slopes()),
+            weighted_diagonal: Vec::new(),
+            mean_diagonal: Vec::new(),
+        };
         if let UvPairs::Empirical(uv) = &self.uv {
-            let (weighted, total) = self.sum_over_sets(
+            let (weighted, total) = sum_over_sets(
+                set.terms.len(),
                 &uv.sets,
-                |set, scratch, d| self.layer_sums.diagonals(set, scratch, d),
-                |d| crate::sum::sum(self.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)),
+                |q, scratch, d| set.layer_sums.diagonals(q, scratch, d),
+                |d| crate::sum::sum(set.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)),
             );
             let r = uv.sets.len() as f64;
-            let mean_diagonal = total.iter().map(|t| t / r).collect();
-            if let UvPairs::Empirical(uv) = &mut self.uv {
-                uv.weighted_diagonal = weighted;
-                uv.mean_diagonal = mean_diagonal;
-            }
+            set.weighted_diagonal = weighted;
+            set.mean_diagonal = total.iter().map(|t| t / r).collect();
         }
+        set
     }
 
     /// J(a, b).
     pub fn value(&self, a: f64, b: f64) -> f64 {
         self.evaluations.fetch_add(1, Ordering::Relaxed);
+        self.value_on(&self.full, [a, b])
+    }
+
+    /// J(a, b) summed over the coarse set only: the [`COARSE_TERMS`]
+    /// frequencies with the largest bounds, which vary slowest with the
+    /// shear. Not J (the other terms are left out, without a bound), but
+    /// its basins are where J's are, and it costs a fraction of J at
+    /// large N: for scans that locate basins before J refines them.
+    pub fn coarse_value(&self, a: f64, b: f64) -> f64 {
+        self.coarse_evaluations.fetch_add(1, Ordering::Relaxed);
+        self.value_on(&self.coarse, [a, b])
+    }
+
+    /// The sum of J over the terms of `set`.
+    fn value_on(&self, set: &TermSet, [a, b]: [f64; 2]) -> f64 {
         let base = self.variance / self.n as f64;
         let uv = match &self.uv {
             UvPairs::Empirical(uv) => {
-                return base + mean(&self.per_realization(uv, [a, b]));
+                return base + mean(&self.per_realization(set, uv, [a, b]));
             }
             UvPairs::Exact(uv) => *uv,
         };
-        let partial: Vec<NeumaierSum> = self
+        let partial: Vec<NeumaierSum> = set
             .terms
             .par_chunks(CHUNK)
             .map(|chunk| {
@@ -475,15 +508,15 @@ impl<'a> ShearObjective<'a> {
     /// J − Var f/N on each realization of the (u, v) half (the (x, y) half
     /// at its mean), computed per realization so the result is the same
     /// for any number of threads.
-    fn per_realization(&self, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
+    fn per_realization(&self, terms: &TermSet, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
         uv.sets
             .par_iter()
-            .zip(&uv.weighted_diagonal)
+            .zip(&terms.weighted_diagonal)
             .map_init(
-                || (Scratch::default(), vec![0.0; self.terms.len()]),
+                || (Scratch::default(), vec![0.0; terms.terms.len()]),
                 |(scratch, sums), (set, diagonal)| {
-                    self.layer_sums.power_sums(set, shear, scratch, sums);
-                    let power = self
+                    terms.layer_sums.power_sums(set, shear, scratch, sums);
+                    let power = terms
                         .terms
                         .iter()
                         .zip(sums.iter())
@@ -496,55 +529,19 @@ impl<'a> ShearObjective<'a> {
 
     /// The mean over the (u, v) realizations of each term's pair sum.
     fn mean_pair_sums(&self, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
-        let (_, total) = self.sum_over_sets(
+        let full = &self.full;
+        let (_, total) = sum_over_sets(
+            full.terms.len(),
             &uv.sets,
-            |set, scratch, sums| self.layer_sums.power_sums(set, shear, scratch, sums),
+            |set, scratch, sums| full.layer_sums.power_sums(set, shear, scratch, sums),
             |_| 0.0,
         );
         let r = uv.sets.len() as f64;
         total
             .iter()
-            .zip(&uv.mean_diagonal)
+            .zip(&full.mean_diagonal)
             .map(|(t, d)| t / r - d)
             .collect()
-    }
-
-    /// The per-term vectors `fill` writes for each of `sets`, summed over
-    /// the sets, and `scalar` of each set's vector, in fixed chunks of
-    /// [`CHUNK`] sets (memory: chunks × terms, not sets × terms; the same
-    /// sums for any number of threads).
-    fn sum_over_sets(
-        &self,
-        sets: &[PointSet],
-        fill: impl Fn(&PointSet, &mut Scratch, &mut [f64]) + Sync,
-        scalar: impl Fn(&[f64]) -> f64 + Sync,
-    ) -> (Vec<f64>, Vec<f64>) {
-        let terms = self.terms.len();
-        let partial: Vec<(Vec<f64>, Vec<f64>)> = sets
-            .par_chunks(CHUNK)
-            .map(|chunk| {
-                let mut scratch = Scratch::default();
-                let mut v = vec![0.0; terms];
-                let mut total = vec![0.0; terms];
-                let mut scalars = Vec::with_capacity(chunk.len());
-                for set in chunk {
-                    fill(set, &mut scratch, &mut v);
-                    scalars.push(scalar(&v));
-                    for (t, x) in total.iter_mut().zip(&v) {
-                        *t += x;
-                    }
-                }
-                (scalars, total)
-            })
-            .collect();
-        let scalars = partial
-            .iter()
-            .flat_map(|(s, _)| s.iter().copied())
-            .collect();
-        let total = (0..terms)
-            .map(|i| crate::sum::sum(partial.iter().map(|(_, t)| t[i])))
-            .collect();
-        (scalars, total)
     }
 
     /// J at `shear` with its standard error: for an estimated half, the
@@ -569,7 +566,7 @@ impl<'a> ShearObjective<'a> {
         let value = match &self.uv {
             UvPairs::Empirical(uv) => {
                 self.evaluations.fetch_add(1, Ordering::Relaxed);
-                let per_set = self.per_realization(uv, [a, b]);
+                let per_set = self.per_realization(&self.full, uv, [a, b]);
                 variances[1] = sample_variance(&per_set) / per_set.len() as f64;
                 base + mean(&per_set)
             }
@@ -581,12 +578,14 @@ impl<'a> ShearObjective<'a> {
             let uv_sums: Vec<f64> = match &self.uv {
                 UvPairs::Empirical(uv) => self.mean_pair_sums(uv, [a, b]),
                 UvPairs::Exact(uv) => self
+                    .full
                     .terms
                     .iter()
                     .map(|t| uv.wave_pair_sum(&t.waves, [a * t.k[0], b * t.k[1]]))
                     .collect(),
             };
             let uv_part: Vec<(usize, f64)> = self
+                .full
                 .terms
                 .iter()
                 .zip(uv_sums)
@@ -630,7 +629,12 @@ impl<'a> ShearObjective<'a> {
 
     /// Frequencies k (of the half-plane, each standing for ±k) in the sum.
     pub fn terms(&self) -> usize {
-        self.terms.len()
+        self.full.terms.len()
+    }
+
+    /// Frequencies in the coarse J ([`ShearObjective::coarse_value`]).
+    pub fn coarse_terms(&self) -> usize {
+        self.coarse.terms.len()
     }
 
     /// Box half-width h of the sum.
@@ -654,6 +658,11 @@ impl<'a> ShearObjective<'a> {
     /// Evaluations of J so far.
     pub fn evaluations(&self) -> u64 {
         self.evaluations.load(Ordering::Relaxed)
+    }
+
+    /// Evaluations of the coarse J ([`ShearObjective::coarse_value`]) so far.
+    pub fn coarse_evaluations(&self) -> u64 {
+        self.coarse_evaluations.load(Ordering::Relaxed)
     }
 }
 
@@ -683,6 +692,43 @@ fn box_index(freqs: &FrequencyBox, k: [i64; 2]) -> usize {
     let side = freqs.side() as i64;
     let h = freqs.half as i64;
     ((k[1] + h) * side + k[0] + h) as usize
+}
+
+/// The per-term vectors `fill` writes for each of `sets`, summed over
+/// the sets, and `scalar` of each set's vector, in fixed chunks of
+/// [`CHUNK`] sets (memory: chunks × terms, not sets × terms; the same
+/// sums for any number of threads).
+fn sum_over_sets(
+    terms: usize,
+    sets: &[PointSet],
+    fill: impl Fn(&PointSet, &mut Scratch, &mut [f64]) + Sync,
+    scalar: impl Fn(&[f64]) -> f64 + Sync,
+) -> (Vec<f64>, Vec<f64>) {
+    let partial: Vec<(Vec<f64>, Vec<f64>)> = sets
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut scratch = Scratch::default();
+            let mut v = vec![0.0; terms];
+            let mut total = vec![0.0; terms];
+            let mut scalars = Vec::with_capacity(chunk.len());
+            for set in chunk {
+                fill(set, &mut scratch, &mut v);
+                scalars.push(scalar(&v));
+                for (t, x) in total.iter_mut().zip(&v) {
+                    *t += x;
+                }
+            }
+            (scalars, total)
+        })
+        .collect();
+    let scalars = partial
+        .iter()
+        .flat_map(|(s, _)| s.iter().copied())
+        .collect();
+    let total = (0..terms)
+        .map(|i| crate::sum::sum(partial.iter().map(|(_, t)| t[i])))
+        .collect();
+    (scalars, total)
 }
 
 /// Realizations 0..count of `sampler` from `seed`.
