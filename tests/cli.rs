@@ -1075,7 +1075,8 @@ fn bench_samplers_lists_each_sampler_at_the_sizes_it_makes() {
 /// `bench shear --quick`: the shear objective's pair sums by powers of one
 /// phasor per point agree with the direct sums (a sine and cosine per
 /// point, wave and term) to rounding, in units of the bound N(N − 1)(Σ|A|)²
-/// per realization: the products' phase error is ~k·ε at |k| ≤ 32.
+/// per realization: the products' phase error is ~k·ε at |k| ≤ 32; by a
+/// NUFFT at tolerance ε, within 2ε (|ΔS| ≤ ε·N moves |S|² by ≤ 2ε·N²).
 #[test]
 fn bench_shear_powers_agree_with_the_direct_sums() {
     let dir = temp_dir("bench-shear");
@@ -1094,11 +1095,19 @@ fn bench_shear_powers_agree_with_the_direct_sums() {
             "threads"
         ]
     );
-    // Two light fields at N = 64 and 256, direct and powers each.
-    assert_eq!(rows.len(), 8);
+    // Two light fields at N = 64 and 256: direct, powers, two NUFFTs each.
+    assert_eq!(rows.len(), 16);
     for r in rows.iter().filter(|r| r[1] == *"powers") {
         let error: f64 = r[4].parse().unwrap();
         assert!(error <= 1e-13, "{}: {error:e}", &r[0]);
+    }
+    for (method, tolerance) in [("nufft 1e-6", 1e-6), ("nufft 1e-9", 1e-9)] {
+        let transformed: Vec<_> = rows.iter().filter(|r| r[1] == *method).collect();
+        assert_eq!(transformed.len(), 4, "{method}: {rows:?}");
+        for r in transformed {
+            let error: f64 = r[4].parse().unwrap();
+            assert!(error <= 2.0 * tolerance, "{} {method}: {error:e}", &r[0]);
+        }
     }
     assert_eq!(rows.iter().filter(|r| r[1] == *"direct").count(), 4);
 }

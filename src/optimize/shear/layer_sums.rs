@@ -17,12 +17,68 @@
 //! rounding of the phase k·ω·q a direct sum would reduce. The diagonal
 //! Σ_l |ψ_k(q_l)|² does not depend on σ: N·Σ_t|A_t|² plus the cross terms
 //! of the waves, powers of the slope differences s_t − s_t′.
+//!
+//! Where the terms fill much of a box |k|∞ ≤ H and N is large (N = 4096:
+//! 155,864 terms of |k|∞ ≤ 1024), one type-1 NUFFT per wave of the scaled
+//! points (frac(w_x·u_l), frac(w_y·v_l)) gives every S(k) of the box at
+//! once (k is an integer, so e^(2πi k·w·u) = e^(2πi k·frac(w·u))), with
+//! |ΔS(k)| ≤ ε·N at tolerance ε ([`TRANSFORM_TOLERANCE`]); the terms
+//! outside the box (the axes beyond H) keep the powers. A cost model of
+//! sizes only chooses, so the sums are the same for any thread count.
 
 use rustfft::num_complex::Complex64;
 
 use crate::integrands::LightField;
-use crate::points::PointSet;
+use crate::points::{PointSet, wrap01};
+use crate::spectrum::FrequencyBox;
+use crate::spectrum::nufft::{NufftPlan, NufftScratch, Sign, Upsampling};
 use crate::spectrum::pair::turn;
+
+/// Relative tolerance ε of the box transform: |ΔS(k)| ≤ ε·N (Barnett,
+/// Magland & af Klinteberg 2019, §3), where the pair sums J needs are of
+/// order N² at the shear that matters and 1e-2 of J is the target.
+pub const TRANSFORM_TOLERANCE: f64 = 1e-9;
+/// The cost model that chooses between the two, in nanoseconds on two
+/// cores (`varspec bench shear` and the search at N = 4096, |k|∞ ≤ 1024):
+/// a dot product costs [`DOT_NS`] per term and point; a transform
+/// [`SPREAD_NS`] per point and kernel weight (w² in 2D), [`FFT_NS`] per
+/// grid cell·log2(cells), and [`TRANSFORM_OVERHEAD_NS`] per call.
+const DOT_NS: f64 = 0.4;
+/// See [`DOT_NS`].
+const SPREAD_NS: f64 = 0.5;
+/// See [`DOT_NS`].
+const FFT_NS: f64 = 0.53;
+/// See [`DOT_NS`].
+const TRANSFORM_OVERHEAD_NS: f64 = 3e5;
+
+/// How the sums of the terms in the box are taken.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SumMethod {
+    /// Powers of one phasor per point and axis, one dot product per term.
+    Powers,
+    /// One type-1 NUFFT per wave at this tolerance for the terms in the box
+    /// of the off-axis terms, powers for the rest.
+    Transform {
+        /// Relative tolerance ε (|ΔS(k)| ≤ ε·N).
+        tolerance: f64,
+    },
+    /// The transform at [`TRANSFORM_TOLERANCE`] where the cost model says
+    /// it is cheaper for sets of `points` points, else powers. (Where the
+    /// memory budget refuses the transform's grids, powers too: the sums
+    /// then differ in the last ~10 digits, far inside J's truncation
+    /// bound.)
+    Auto {
+        /// Points per (u, v) set.
+        points: usize,
+    },
+}
+
+/// The terms summed by a type-1 NUFFT on a box.
+struct BoxTransform {
+    plan: NufftPlan,
+    /// (position in the term list, index in the box) of each term in it.
+    terms: Vec<(usize, usize)>,
+}
 
 /// One run of frequencies (k_x, k_y0 + j), j < len, at positions
 /// first + j of the term list; `e_row` and `f_row` are the table rows of
@@ -49,6 +105,9 @@ pub struct LayerSums {
     slopes: Vec<[f64; 2]>,
     /// A_t(k), term-major (one per slope).
     amplitudes: Vec<Complex64>,
+    /// The terms in a box, when a transform sums them (the runs hold the
+    /// rest).
+    transform: Option<BoxTransform>,
 }
 
 /// Buffers of one thread.
@@ -59,6 +118,8 @@ pub(super) struct Scratch {
     /// Σ_l of each wave's phasor, per term: re then im, wave-major.
     re: Vec<f64>,
     im: Vec<f64>,
+    /// The transform's grids and box of sums.
+    transform: Option<(NufftScratch, Vec<Complex64>)>,
 }
 
 impl Scratch {
@@ -83,12 +144,21 @@ fn number_rows(rows: &mut [Option<usize>]) -> usize {
 
 impl LayerSums {
     /// `ks` in the order of (k_x, k_y), each with k_x ≥ 0, and the
-    /// amplitudes of its waves (one per slope).
+    /// amplitudes of its waves (one per slope), summed by `method`.
+    ///
+    /// A transform the NUFFT refuses (tolerance outside [1e-14, 0.1],
+    /// grids past the memory budget) leaves every term to the powers
+    /// ([`LayerSums::transforms`] says which).
     ///
     /// # Panics
     /// If `ks` is not sorted with k_x ≥ 0 or the amplitudes are not one per
     /// slope and frequency (callers build both from one light field).
-    pub(super) fn new(ks: &[[i64; 2]], amplitudes: Vec<Complex64>, slopes: Vec<[f64; 2]>) -> Self {
+    pub(super) fn new(
+        ks: &[[i64; 2]],
+        amplitudes: Vec<Complex64>,
+        slopes: Vec<[f64; 2]>,
+        method: SumMethod,
+    ) -> Self {
         assert!(
             ks.windows(2).all(|w| w[0] < w[1]) && ks.iter().all(|k| k[0] >= 0),
             "layer sums need distinct frequencies sorted by (k_x, k_y) with k_x >= 0"
@@ -98,19 +168,34 @@ impl LayerSums {
             ks.len() * slopes.len(),
             "one amplitude per wave"
         );
-        let kx_max = ks.iter().map(|k| k[0]).max().unwrap_or(0);
-        let ky_max = ks.iter().map(|k| k[1].abs()).max().unwrap_or(0);
+        let transform = box_transform(ks, method);
+        let by_powers: Vec<usize> = match &transform {
+            Some(t) => {
+                let mut in_box = vec![false; ks.len()];
+                for &(i, _) in &t.terms {
+                    in_box[i] = true;
+                }
+                (0..ks.len()).filter(|&i| !in_box[i]).collect()
+            }
+            None => (0..ks.len()).collect(),
+        };
+        let kx_max = by_powers.iter().map(|&i| ks[i][0]).max().unwrap_or(0);
+        let ky_max = by_powers.iter().map(|&i| ks[i][1].abs()).max().unwrap_or(0);
         let mut e_rows = vec![None; kx_max as usize + 1];
         let mut f_rows = vec![None; 2 * ky_max as usize + 1];
-        for k in ks {
-            e_rows[k[0] as usize] = Some(0);
-            f_rows[(k[1] + ky_max) as usize] = Some(0);
+        for &i in &by_powers {
+            e_rows[ks[i][0] as usize] = Some(0);
+            f_rows[(ks[i][1] + ky_max) as usize] = Some(0);
         }
         number_rows(&mut e_rows);
         number_rows(&mut f_rows);
         let mut runs: Vec<Run> = Vec::new();
-        for (i, k) in ks.iter().enumerate() {
-            let extends = i > 0 && ks[i - 1][0] == k[0] && ks[i - 1][1] + 1 == k[1];
+        for (j, &i) in by_powers.iter().enumerate() {
+            let k = ks[i];
+            let extends = j > 0 && {
+                let p = by_powers[j - 1];
+                p + 1 == i && ks[p][0] == k[0] && ks[p][1] + 1 == k[1]
+            };
             match runs.last_mut() {
                 Some(r) if extends => r.len += 1,
                 _ => runs.push(Run {
@@ -128,20 +213,27 @@ impl LayerSums {
             terms: ks.len(),
             slopes,
             amplitudes,
+            transform,
         }
     }
 
     /// The terms of light field `light` at the frequencies `ks` (k_x ≥ 0,
-    /// sorted by (k_x, k_y)).
+    /// sorted by (k_x, k_y)), summed by `method`.
     ///
     /// # Panics
     /// If `ks` is not sorted with k_x ≥ 0.
-    pub fn for_light_field(light: &dyn LightField, ks: &[[i64; 2]]) -> Self {
+    pub fn for_light_field(light: &dyn LightField, ks: &[[i64; 2]], method: SumMethod) -> Self {
         let mut amplitudes = Vec::new();
         for &k in ks {
             light.wave_amplitudes(k, &mut amplitudes);
         }
-        Self::new(ks, amplitudes, light.wave_slopes())
+        Self::new(ks, amplitudes, light.wave_slopes(), method)
+    }
+
+    /// Whether a transform sums terms: it runs in parallel itself, and its
+    /// grids are large, so callers take the sets one at a time.
+    pub fn transforms(&self) -> bool {
+        self.transform.is_some()
     }
 
     /// The pair sums Σ_(l≠m) ψ_k(q_l)·conj(ψ_k(q_m)) of every term on the
@@ -224,11 +316,35 @@ impl LayerSums {
             tables,
             re,
             im,
+            transform,
         } = scratch;
         let kx_max = self.e_rows.len() - 1;
         let ky_max = (self.f_rows.len() - 1) / 2;
         let re = &mut re[offset..offset + self.terms];
         let im = &mut im[offset..offset + self.terms];
+        if let Some(t) = &self.transform {
+            let (grids, out) = transform.get_or_insert_with(|| {
+                let zero = Complex64::new(0.0, 0.0);
+                (
+                    t.plan.make_scratch(),
+                    vec![zero; t.plan.frequencies().len()],
+                )
+            });
+            let coords = set
+                .coords()
+                .chunks_exact(2)
+                .flat_map(|q| [wrap01(w[0] * q[0]), wrap01(w[1] * q[1])])
+                .collect();
+            let scaled = PointSet::new(2, coords).expect("wrapped coordinates lie in [0, 1)");
+            t.plan.type1(&scaled, None, Sign::Positive, out, grids);
+            for &(i, b) in &t.terms {
+                re[i] += out[b].re;
+                im[i] += out[b].im;
+            }
+            if self.runs.is_empty() {
+                return;
+            }
+        }
         for block in set.coords().chunks(2 * self.points_per_block()) {
             let n = block.len() / 2;
             let rows = |table: &[Option<usize>]| table.iter().flatten().count() * n;
@@ -303,6 +419,47 @@ impl LayerSums {
     fn add_dots_avx2(&self, tables: &Tables, n: usize, re: &mut [f64], im: &mut [f64]) {
         self.add_dots(tables, n, re, im);
     }
+}
+
+/// The transform for the terms of `ks` in the box of its off-axis terms,
+/// when `method` asks for one (or the cost model prefers it).
+fn box_transform(ks: &[[i64; 2]], method: SumMethod) -> Option<BoxTransform> {
+    let half = ks
+        .iter()
+        .filter(|k| k[0] != 0 && k[1] != 0)
+        .map(|k| k[0].max(k[1].abs()))
+        .max()? as usize;
+    let in_box = |k: &[i64; 2]| k[0].max(k[1].abs()) as usize <= half;
+    let freqs = FrequencyBox { dim: 2, half };
+    let (tolerance, points) = match method {
+        SumMethod::Powers => return None,
+        SumMethod::Transform { tolerance } => (tolerance, 0),
+        SumMethod::Auto { points } => (TRANSFORM_TOLERANCE, points),
+    };
+    // Refused (a tolerance out of range, or grids past the memory budget):
+    // the powers sum every term.
+    let plan = NufftPlan::with_upsampling(freqs, tolerance, Upsampling::Auto { points }).ok()?;
+    let side = freqs.side();
+    let terms: Vec<(usize, usize)> = ks
+        .iter()
+        .enumerate()
+        .filter(|(_, k)| in_box(k))
+        .map(|(i, k)| {
+            let b = (k[1] + half as i64) as usize * side + (k[0] + half as i64) as usize;
+            (i, b)
+        })
+        .collect();
+    if let SumMethod::Auto { points } = method {
+        let cells = (plan.grid_size() as f64).powi(2);
+        let n = points as f64;
+        let transform = SPREAD_NS * n * (plan.kernel_width() as f64).powi(2)
+            + FFT_NS * cells * cells.log2()
+            + TRANSFORM_OVERHEAD_NS;
+        if DOT_NS * terms.len() as f64 * n <= transform {
+            return None;
+        }
+    }
+    Some(BoxTransform { plan, terms })
 }
 
 /// The tables' size per thread that sets the points per block: whole sets
@@ -431,8 +588,16 @@ mod tests {
         let amplitudes: Vec<Complex64> = (0..ks.len() * slopes.len())
             .map(|_| Complex64::new(uniform(&mut rng) - 0.5, uniform(&mut rng) - 0.5))
             .collect();
-        let sums = LayerSums::new(&ks, amplitudes.clone(), slopes.clone());
+        let sums = LayerSums::new(&ks, amplitudes.clone(), slopes.clone(), SumMethod::Powers);
         assert!(sums.points_per_block() < 97, "{}", sums.points_per_block());
+        // The box |k|∞ ≤ 9 by a transform at 1e-12, the axes beyond by powers.
+        let transformed = LayerSums::new(
+            &ks,
+            amplitudes.clone(),
+            slopes.clone(),
+            SumMethod::Transform { tolerance: 1e-12 },
+        );
+        assert!(transformed.transforms() && !sums.transforms());
         let direct = EmpiricalPairs::new(vec![set.clone()]);
         let shear = [-0.37, 1.21];
         let mut scratch = Scratch::default();
@@ -440,6 +605,11 @@ mod tests {
         sums.power_sums(&set, shear, &mut scratch, &mut power);
         let mut diagonal = vec![0.0; ks.len()];
         sums.diagonals(&set, &mut scratch, &mut diagonal);
+        let mut scratch = Scratch::default();
+        let mut power_t = vec![0.0; ks.len()];
+        transformed.power_sums(&set, shear, &mut scratch, &mut power_t);
+        let mut diagonal_t = vec![0.0; ks.len()];
+        transformed.diagonals(&set, &mut scratch, &mut diagonal_t);
         for (i, k) in ks.iter().enumerate() {
             let waves: Vec<PlaneWave> = slopes
                 .iter()
@@ -465,6 +635,57 @@ mod tests {
                 (ours - expected).abs() <= 1e-11 * scale,
                 "k = {k:?}: table {ours} vs direct {expected}"
             );
+            // |ΔS| ≤ ε·N per wave moves |Σ_t A_t S_t|² by at most
+            // 2·ε·N·(Σ_t|A_t|)²·N (+ its square): 2e-12 of the scale, and
+            // the diagonal's cross terms as much again.
+            let transform = power_t[i] - diagonal_t[i];
+            assert!(
+                (transform - expected).abs() <= 1e-11 * scale,
+                "k = {k:?}: transform {transform} vs direct {expected}"
+            );
         }
+    }
+
+    /// The transform runs in parallel inside: its sums are the same bits
+    /// on one thread and on three.
+    #[test]
+    fn transformed_sums_do_not_depend_on_the_thread_count() {
+        let mut rng = set_rng(11, 0);
+        // More points than one spreading task takes (4096).
+        let coords: Vec<f64> = (0..2 * 10_000).map(|_| uniform(&mut rng)).collect();
+        let set = PointSet::new(2, coords).unwrap();
+        let slopes = vec![[0.45, 0.45], [-0.3, -0.3]];
+        let ks: Vec<[i64; 2]> = (0..=40i64)
+            .flat_map(|kx| (-40..=40i64).map(move |ky| [kx, ky]))
+            .filter(|k| k[0] > 0 || k[1] > 0)
+            .chain((41..=300).flat_map(|k| [[0, k], [k, 0]]))
+            .collect::<std::collections::BTreeSet<_>>()
+            .into_iter()
+            .collect();
+        let amplitudes: Vec<Complex64> = (0..ks.len() * slopes.len())
+            .map(|_| Complex64::new(uniform(&mut rng) - 0.5, uniform(&mut rng) - 0.5))
+            .collect();
+        let sums = LayerSums::new(
+            &ks,
+            amplitudes,
+            slopes,
+            SumMethod::Transform { tolerance: 1e-9 },
+        );
+        assert!(sums.transforms());
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| sums.pair_sums(&set, [0.2, -0.7]))
+        };
+        let one = on(1);
+        let three = on(3);
+        assert!(
+            one.iter()
+                .zip(&three)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "sums differ between one and three threads"
+        );
     }
 }

@@ -23,7 +23,7 @@ use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::brent::BrentOpt;
 use argmin::solver::neldermead::NelderMead;
 
-pub use layer_sums::LayerSums;
+pub use layer_sums::{LayerSums, SumMethod};
 pub use objective::{Evaluation, ObjectiveOptions, ShearObjective};
 pub use start::{PlaneDirections, SpectralStart, spectral_start};
 

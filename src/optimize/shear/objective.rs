@@ -24,7 +24,8 @@
 //! closed forms (random, jitter, multi-jitter, CMJ) J is exact up to the
 //! truncation of the sum, which is reported as a bound; other halves are
 //! estimated from realizations with a standard error, the (u, v) half's
-//! pair sums by powers of one phasor per point ([`super::layer_sums`]).
+//! pair sums by powers of one phasor per point, or by one NUFFT per wave
+//! where the terms fill a large box ([`super::layer_sums`]).
 //!
 //! At the shear a = b = −c of a single defocus layer, σ_k cancels ω(k) = c·k,
 //! C(0, 0) = N(N − 1) and J = Σ_k |G(k)|² p_k / N: the (x, y) set integrates
@@ -36,7 +37,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use rayon::prelude::*;
 
 use super::super::OptimizeError;
-use super::layer_sums::{LayerSums, Scratch};
+use super::layer_sums::{LayerSums, Scratch, SumMethod};
 use crate::integrands::{Integrand, LightField, PlaneWave, light_field_energy};
 use crate::points::PointSet;
 use crate::rng::set_rng;
@@ -443,7 +444,12 @@ impl<'a> ShearObjective<'a> {
             .collect();
         let mut set = TermSet {
             terms,
-            layer_sums: LayerSums::new(&ks, amplitudes, light.wave_slopes()),
+            layer_sums: LayerSums::new(
+                &ks,
+                amplitudes,
+                light.wave_slopes(),
+                SumMethod::Auto { points: self.n },
+            ),
             weighted_diagonal: Vec::new(),
             mean_diagonal: Vec::new(),
         };
@@ -451,6 +457,7 @@ impl<'a> ShearObjective<'a> {
             let (weighted, total) = sum_over_sets(
                 set.terms.len(),
                 &uv.sets,
+                set.layer_sums.transforms(),
                 |q, scratch, d| set.layer_sums.diagonals(q, scratch, d),
                 |d| crate::sum::sum(set.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)),
             );
@@ -508,22 +515,29 @@ impl<'a> ShearObjective<'a> {
     /// J − Var f/N on each realization of the (u, v) half (the (x, y) half
     /// at its mean), computed per realization so the result is the same
     /// for any number of threads.
+    /// (The sets one at a time when a transform sums the terms: it runs in
+    /// parallel itself, on grids too large to hold one per task.)
     fn per_realization(&self, terms: &TermSet, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
+        let init = || (Scratch::default(), vec![0.0; terms.terms.len()]);
+        let one = |(scratch, sums): &mut (Scratch, Vec<f64>),
+                   (set, diagonal): (&PointSet, &f64)| {
+            terms.layer_sums.power_sums(set, shear, scratch, sums);
+            let power = terms
+                .terms
+                .iter()
+                .zip(sums.iter())
+                .map(|(t, p)| t.coefficient * p);
+            crate::sum::sum(power.chain([-diagonal]))
+        };
+        let sets = uv.sets.iter().zip(&terms.weighted_diagonal);
+        if terms.layer_sums.transforms() {
+            let mut buffers = init();
+            return sets.map(|s| one(&mut buffers, s)).collect();
+        }
         uv.sets
             .par_iter()
             .zip(&terms.weighted_diagonal)
-            .map_init(
-                || (Scratch::default(), vec![0.0; terms.terms.len()]),
-                |(scratch, sums), (set, diagonal)| {
-                    terms.layer_sums.power_sums(set, shear, scratch, sums);
-                    let power = terms
-                        .terms
-                        .iter()
-                        .zip(sums.iter())
-                        .map(|(t, p)| t.coefficient * p);
-                    crate::sum::sum(power.chain([-diagonal]))
-                },
-            )
+            .map_init(init, one)
             .collect()
     }
 
@@ -533,6 +547,7 @@ impl<'a> ShearObjective<'a> {
         let (_, total) = sum_over_sets(
             full.terms.len(),
             &uv.sets,
+            full.layer_sums.transforms(),
             |set, scratch, sums| full.layer_sums.power_sums(set, shear, scratch, sums),
             |_| 0.0,
         );
@@ -697,30 +712,34 @@ fn box_index(freqs: &FrequencyBox, k: [i64; 2]) -> usize {
 /// The per-term vectors `fill` writes for each of `sets`, summed over
 /// the sets, and `scalar` of each set's vector, in fixed chunks of
 /// [`CHUNK`] sets (memory: chunks × terms, not sets × terms; the same
-/// sums for any number of threads).
+/// sums for any number of threads); the chunks one at a time when
+/// `sequential` (for sums a transform takes: see `per_realization`).
 fn sum_over_sets(
     terms: usize,
     sets: &[PointSet],
+    sequential: bool,
     fill: impl Fn(&PointSet, &mut Scratch, &mut [f64]) + Sync,
     scalar: impl Fn(&[f64]) -> f64 + Sync,
 ) -> (Vec<f64>, Vec<f64>) {
-    let partial: Vec<(Vec<f64>, Vec<f64>)> = sets
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            let mut scratch = Scratch::default();
-            let mut v = vec![0.0; terms];
-            let mut total = vec![0.0; terms];
-            let mut scalars = Vec::with_capacity(chunk.len());
-            for set in chunk {
-                fill(set, &mut scratch, &mut v);
-                scalars.push(scalar(&v));
-                for (t, x) in total.iter_mut().zip(&v) {
-                    *t += x;
-                }
+    let chunk_sums = |chunk: &[PointSet]| {
+        let mut scratch = Scratch::default();
+        let mut v = vec![0.0; terms];
+        let mut total = vec![0.0; terms];
+        let mut scalars = Vec::with_capacity(chunk.len());
+        for set in chunk {
+            fill(set, &mut scratch, &mut v);
+            scalars.push(scalar(&v));
+            for (t, x) in total.iter_mut().zip(&v) {
+                *t += x;
             }
-            (scalars, total)
-        })
-        .collect();
+        }
+        (scalars, total)
+    };
+    let partial: Vec<(Vec<f64>, Vec<f64>)> = if sequential {
+        sets.chunks(CHUNK).map(chunk_sums).collect()
+    } else {
+        sets.par_chunks(CHUNK).map(chunk_sums).collect()
+    };
     let scalars = partial
         .iter()
         .flat_map(|(s, _)| s.iter().copied())
