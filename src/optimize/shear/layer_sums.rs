@@ -434,6 +434,12 @@ fn box_transform(ks: &[[i64; 2]], method: SumMethod) -> Option<BoxTransform> {
     let (tolerance, points) = match method {
         SumMethod::Powers => return None,
         SumMethod::Transform { tolerance } => (tolerance, 0),
+        // Dot products cheaper than a transform's overhead alone: no plan.
+        SumMethod::Auto { points }
+            if DOT_NS * (ks.len() * points) as f64 <= TRANSFORM_OVERHEAD_NS =>
+        {
+            return None;
+        }
         SumMethod::Auto { points } => (TRANSFORM_TOLERANCE, points),
     };
     // Refused (a tolerance out of range, or grids past the memory budget):
