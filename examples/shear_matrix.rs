@@ -84,7 +84,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &starts,
                 ObjectiveOptions::default(),
             )?;
-            let found = search_shear(&objective, &spectral, 2.0)?;
+            let found = search_shear(&objective, &spectral, 2.0, &|_| {})?;
             let seconds = start.elapsed().as_secs_f64();
             let layers = f
                 .light_field()

@@ -7,7 +7,7 @@
 
 use varspec::integrands;
 use varspec::optimize::shear::{
-    ObjectiveOptions, ShearObjective, Sheared, search_shear, shear_set, spectral_start,
+    ObjectiveOptions, SearchStage, ShearObjective, Sheared, search_shear, shear_set, spectral_start,
 };
 use varspec::registry;
 use varspec::rng::set_rng;
@@ -116,7 +116,7 @@ fn search_finds_the_light_field_shear_with_its_sign() {
         let c = f.light_field().unwrap().layer_shears()[0][0];
         let s = registry::build("umj", n, Some(4), &[]).unwrap();
         let (objective, start) = objective(f.as_ref(), s.as_ref());
-        let found = search_shear(&objective, &start, 2.0).unwrap();
+        let found = search_shear(&objective, &start, 2.0, &|_| {}).unwrap();
         for (axis, a) in found.shear.iter().enumerate() {
             assert!(
                 (a - c).abs() <= 0.02,
@@ -140,7 +140,7 @@ fn the_search_gain_holds_on_fresh_realizations() {
     let f = integrands::parse("defocus:shape=disk,size=0.33,c=-0.52").unwrap();
     let s = registry::build("umj", 256, Some(4), &[]).unwrap();
     let (objective, start) = objective(f.as_ref(), s.as_ref());
-    let found = search_shear(&objective, &start, 2.0).unwrap();
+    let found = search_shear(&objective, &start, 2.0, &|_| {}).unwrap();
     let (before, se_before) = brute_force(f.as_ref(), s.as_ref(), [0.0, 0.0], 4000);
     let (after, se_after) = brute_force(f.as_ref(), s.as_ref(), found.shear, 4000);
     // At least 4x lower at the unfavourable ends of the 3.89σ intervals.
@@ -156,15 +156,27 @@ fn no_shear_is_kept_when_nothing_is_better() {
     let f = integrands::parse("defocus:shape=box,size=0.3,c=0").unwrap();
     let s = registry::build("umj", 64, Some(4), &[]).unwrap();
     let (objective, start) = objective(f.as_ref(), s.as_ref());
-    let found = search_shear(&objective, &start, 2.0).unwrap();
+    let stages = std::cell::RefCell::new(Vec::new());
+    let found = search_shear(&objective, &start, 2.0, &|s| stages.borrow_mut().push(s)).unwrap();
+    // The progress display hears every stage, in order.
+    assert_eq!(
+        stages.into_inner(),
+        [
+            SearchStage::Candidates,
+            SearchStage::Line(0),
+            SearchStage::Line(1),
+            SearchStage::Polish,
+            SearchStage::Sensitivity
+        ]
+    );
     assert!(
         found.shear.iter().all(|a| a.abs() <= 1e-3),
         "{:?}",
         found.shear
     );
     assert!(found.optimum.value <= found.unsheared.value);
-    assert!(search_shear(&objective, &start, f64::INFINITY).is_err());
-    assert!(search_shear(&objective, &start, 0.0).is_err());
+    assert!(search_shear(&objective, &start, f64::INFINITY, &|_| {}).is_err());
+    assert!(search_shear(&objective, &start, 0.0, &|_| {}).is_err());
 }
 
 #[test]
@@ -198,7 +210,7 @@ fn double_wedges_are_told_from_single_layers() {
             ObjectiveOptions::default(),
         )
         .unwrap();
-        let found = search_shear(&objective, &start, 2.0).unwrap();
+        let found = search_shear(&objective, &start, 2.0, &|_| {}).unwrap();
         assert!(found.optimum.value <= found.unsheared.value, "{spec}");
     }
 }
@@ -224,7 +236,7 @@ fn estimated_halves_report_their_standard_error() {
         xy == 0 && uv >= 2,
         "only the (u, v) half is estimated: {xy}, {uv}"
     );
-    let found = search_shear(&objective, &start, 2.0).unwrap();
+    let found = search_shear(&objective, &start, 2.0, &|_| {}).unwrap();
     assert!(
         found.shear.iter().all(|a| (a + 0.4).abs() <= 0.02),
         "{:?}",

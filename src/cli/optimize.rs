@@ -765,6 +765,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         a.seed,
         a.range,
         a.realizations,
+        &|stage| spinner.set_message(format!("searching the shear: {stage}")),
     );
     spinner.finish_and_clear();
     let run = run?;

@@ -564,6 +564,7 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
         o.seed,
         2.0,
         4000,
+        &|_| {},
     )
     .map_err(at("shear search"))?;
     let (found, seconds) = (&run.found, run.search_seconds);

@@ -104,7 +104,7 @@ pub fn check_request(
 
 /// Searches the shear of `sampler` (named `sampler_name`) for `f` within
 /// [−range, range]² and checks it on `realizations` fresh realizations
-/// (0: no check).
+/// (0: no check), telling `progress` what it does next.
 ///
 /// # Errors
 /// [`OptimizeError::Option`] for a non-4D integrand, a bad range or
@@ -116,9 +116,11 @@ pub fn search_and_check(
     seed: u64,
     range: f64,
     realizations: usize,
+    progress: &dyn Fn(String),
 ) -> Result<CheckedShear, OptimizeError> {
     check_request(f, range, realizations)?;
     let start = std::time::Instant::now();
+    progress("the integrand's spectrum and the frequency terms".into());
     let spectral = spectral_start(f, 64, range);
     let mut starts = spectral.candidates();
     starts.push([0.0, 0.0]);
@@ -127,7 +129,9 @@ pub fn search_and_check(
         ..ObjectiveOptions::default()
     };
     let objective = ShearObjective::new(f, sampler, &starts, options)?;
-    let found = search_shear(&objective, &spectral, range)?;
+    let found = search_shear(&objective, &spectral, range, &|s| {
+        progress(s.to_string());
+    })?;
     let search_seconds = start.elapsed().as_secs_f64();
     let eval_seed = seed ^ 0x0e7a_1000;
     let estimate = |shear: [f64; 2]| -> Result<EmpiricalEstimate, OptimizeError> {
@@ -143,6 +147,7 @@ pub fn search_and_check(
         )?)
     };
     let check = if realizations >= 2 {
+        progress(format!("checking on {realizations} fresh realizations"));
         Some((estimate([0.0, 0.0])?, estimate(found.shear)?))
     } else {
         None

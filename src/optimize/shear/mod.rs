@@ -64,6 +64,31 @@ pub struct ShearResult {
     pub coarse_evaluations: u64,
 }
 
+/// What the search is doing, for a progress display.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SearchStage {
+    /// J at the spectral candidates and at (0, 0).
+    Candidates,
+    /// The scans and Brent's method along one axis (0: a, 1: b).
+    Line(usize),
+    /// Nelder–Mead on (a, b) jointly.
+    Polish,
+    /// J at the optimum ± [`SENSITIVITY_STEP`].
+    Sensitivity,
+}
+
+impl std::fmt::Display for SearchStage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SearchStage::Candidates => write!(f, "J at the spectral candidates"),
+            SearchStage::Line(0) => write!(f, "scanning a (coarse J, then J)"),
+            SearchStage::Line(_) => write!(f, "scanning b (coarse J, then J)"),
+            SearchStage::Polish => write!(f, "polishing (a, b) jointly"),
+            SearchStage::Sensitivity => write!(f, "J at the optimum ± {SENSITIVITY_STEP}"),
+        }
+    }
+}
+
 /// J along one coordinate, the other held fixed, for Brent's method.
 struct Line<'o, 'a> {
     objective: &'o ShearObjective<'a>,
@@ -117,7 +142,8 @@ impl CostFunction for Joint<'_, '_> {
 /// O(range) evaluations.
 pub const MAX_SHEAR_RANGE: f64 = 64.0;
 
-/// Searches (a, b) in [−`range`, `range`]² from the spectral `start`.
+/// Searches (a, b) in [−`range`, `range`]² from the spectral `start`,
+/// telling `stage` what it does next.
 ///
 /// # Errors
 /// [`OptimizeError::Option`] for a range that is not finite and positive;
@@ -126,6 +152,7 @@ pub fn search_shear(
     objective: &ShearObjective,
     start: &SpectralStart,
     range: f64,
+    stage: &dyn Fn(SearchStage),
 ) -> Result<ShearResult, OptimizeError> {
     if !(range.is_finite() && range > 0.0 && range <= MAX_SHEAR_RANGE) {
         return Err(OptimizeError::Option(format!(
@@ -133,6 +160,7 @@ pub fn search_shear(
         )));
     }
     let clamp = |s: [f64; 2]| [s[0].clamp(-range, range), s[1].clamp(-range, range)];
+    stage(SearchStage::Candidates);
     let unsheared = objective.evaluate([0.0, 0.0])?;
     let initial = clamp(start.shear);
     let initial_value = objective.value(initial[0], initial[1]);
@@ -146,6 +174,7 @@ pub fn search_shear(
     let mut shear = best.0;
     for along_a in [true, false] {
         let axis = usize::from(!along_a);
+        stage(SearchStage::Line(axis));
         let line = Line {
             objective,
             fixed: shear[1 - axis],
@@ -154,6 +183,7 @@ pub fn search_shear(
         let (t, _) = refine_line(&line, shear[axis], range)?;
         shear[axis] = t;
     }
+    stage(SearchStage::Polish);
     let lined = objective.value(shear[0], shear[1]);
     let step = 0.05 * SENSITIVITY_STEP;
     let simplex = vec![
@@ -181,6 +211,7 @@ pub fn search_shear(
         shear = [0.0, 0.0];
         optimum = unsheared;
     }
+    stage(SearchStage::Sensitivity);
     let d = SENSITIVITY_STEP;
     let sensitivity = [
         objective.value(shear[0] - d, shear[1]),
