@@ -1,5 +1,5 @@
 //! Pair sums of a (u, v) set for a light field of sheared layers, by powers
-//! of one phasor per point.
+//! of one phasor per point or by a NUFFT of the scaled points.
 //!
 //! For frequency k of the (x, y) half and shear σ = (a·k_x, b·k_y), the
 //! shear objective needs, on each realization Q = {q_l} of the (u, v) half,
@@ -24,7 +24,10 @@
 //! once (k is an integer, so e^(2πi k·w·u) = e^(2πi k·frac(w·u))), with
 //! |ΔS(k)| ≤ ε·N at tolerance ε ([`TRANSFORM_TOLERANCE`]); the terms
 //! outside the box (the axes beyond H) keep the powers. A cost model of
-//! sizes only chooses, so the sums are the same for any thread count.
+//! sizes chooses, so the sums are the same for any thread count — except
+//! where the NUFFT's memory budget (which counts a pair of grids per
+//! thread against the memory free) refuses the grids: the powers then sum
+//! every term, and the sums differ in their last ~10 digits.
 
 use rustfft::num_complex::Complex64;
 
@@ -92,7 +95,8 @@ struct Run {
 }
 
 /// The terms of a sheared layer stack: frequencies of the half-plane
-/// k_x ≥ 0 in runs of consecutive k_y, the waves' slopes and amplitudes.
+/// k_x ≥ 0 (those the powers sum in runs of consecutive k_y, the rest in a
+/// transform's box), the waves' slopes and amplitudes.
 #[derive(Default)]
 pub struct LayerSums {
     runs: Vec<Run>,
@@ -306,10 +310,11 @@ impl LayerSums {
     }
 
     /// Adds Σ_l e^(2πi (w_x·k_x·u_l + w_y·k_y·v_l)) for every term to the
-    /// scratch sums from position `offset`: per block of points (the
-    /// whole set where its tables fit in [`TABLE_BYTES`]),
-    /// the rows of E_l^(k_x) and F_l^(k_y) in use (points innermost), then
-    /// one dot product per term.
+    /// scratch sums from position `offset`: the terms in the transform's box
+    /// (if any) from one type-1 NUFFT of the scaled points; the others per
+    /// block of points (the whole set where its tables fit in
+    /// [`TABLE_BYTES`]), the rows of E_l^(k_x) and F_l^(k_y) in use (points
+    /// innermost), then one dot product per term.
     fn add_phasor_sums(&self, set: &PointSet, w: [f64; 2], scratch: &mut Scratch, offset: usize) {
         let Scratch {
             powers,
@@ -323,6 +328,13 @@ impl LayerSums {
         let re = &mut re[offset..offset + self.terms];
         let im = &mut im[offset..offset + self.terms];
         if let Some(t) = &self.transform {
+            // A scratch made for another plan's box is made anew.
+            if transform
+                .as_ref()
+                .is_some_and(|(_, out)| out.len() != t.plan.frequencies().len())
+            {
+                *transform = None;
+            }
             let (grids, out) = transform.get_or_insert_with(|| {
                 let zero = Complex64::new(0.0, 0.0);
                 (

@@ -192,8 +192,10 @@ pub fn search_shear(
         vec![shear[0], shear[1] + step],
     ];
     let solver = NelderMead::new(simplex)
-        // J to 1e-8 of itself: far below its truncation bound and stderr.
-        .with_sd_tolerance(1e-8 * lined)
+        // J to 1e-8 of itself (|J|: an estimated J may come out ≤ 0,
+        // and argmin refuses a negative tolerance): far below its
+        // truncation bound and stderr.
+        .with_sd_tolerance(1e-8 * lined.abs())
         .map_err(|e| OptimizeError::Search(e.to_string()))?;
     let result = Executor::new(Joint(objective), solver)
         .configure(|s| s.max_iters(100))

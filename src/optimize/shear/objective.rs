@@ -52,7 +52,7 @@ const CHUNK: usize = 32;
 /// Largest box half-width of the frequency sum.
 const MAX_HALF: usize = 1024;
 /// Terms of the coarse J: enough for the low frequencies that set the
-/// basins (the box |k|∞ ≤ 32 holds 2,144), a fraction of the full sum's
+/// basins (the half-plane of the box |k|∞ ≤ 32 holds 2,112), a fraction of the full sum's
 /// 12,500–156,000 at N = 256…4096 for an aperture with an edge.
 pub const COARSE_TERMS: usize = 2048;
 /// Box half-width when the (x, y) half is estimated from realizations.
@@ -475,10 +475,11 @@ impl<'a> ShearObjective<'a> {
     }
 
     /// J(a, b) summed over the coarse set only: the [`COARSE_TERMS`]
-    /// frequencies with the largest bounds, which vary slowest with the
-    /// shear. Not J (the other terms are left out, without a bound), but
-    /// its basins are where J's are, and it costs a fraction of J at
-    /// large N: for scans that locate basins before J refines them.
+    /// frequencies with the largest bounds (for the spectra of apertures,
+    /// the low ones, which vary slowest with the shear). Not J (the other
+    /// terms are left out, without a bound); the search only uses it to
+    /// locate basins, which J then compares and refines, and it costs a
+    /// fraction of J at large N.
     pub fn coarse_value(&self, a: f64, b: f64) -> f64 {
         self.coarse_evaluations.fetch_add(1, Ordering::Relaxed);
         self.value_on(&self.coarse, [a, b])
