@@ -262,7 +262,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                 let transforms = sums.transforms();
                 let (seconds, totals) = time(3, || {
                     // A transform runs in parallel itself: sets in turn.
-                    let per_set: Vec<Vec<f64>> = if sums.transforms() {
+                    let per_set: Vec<Vec<f64>> = if transforms {
                         sets.iter().map(|set| sums.pair_sums(set, shear)).collect()
                     } else {
                         sets.par_iter()

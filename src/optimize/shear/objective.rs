@@ -32,6 +32,7 @@
 //! the 2D shape g alone, which is why the light field's own shear is the
 //! optimum wherever p_k < 1.
 
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
@@ -132,6 +133,9 @@ struct TermSet {
     weighted_diagonal: Vec<f64>,
     /// The mean diagonal over the (u, v) realizations, per term.
     mean_diagonal: Vec<f64>,
+    /// The buffers of a transform (its grids: 250 MB at N = 4096), kept
+    /// from one evaluation to the next rather than allocated for each.
+    transform_scratch: Mutex<Scratch>,
 }
 
 /// The objective J(a, b): the expected variance of the (x, y)-shifted
@@ -452,6 +456,7 @@ impl<'a> ShearObjective<'a> {
             ),
             weighted_diagonal: Vec::new(),
             mean_diagonal: Vec::new(),
+            transform_scratch: Mutex::default(),
         };
         if let UvPairs::Empirical(uv) = &self.uv {
             let (weighted, total) = sum_over_sets(
@@ -519,26 +524,39 @@ impl<'a> ShearObjective<'a> {
     /// (The sets one at a time when a transform sums the terms: it runs in
     /// parallel itself, on grids too large to hold one per task.)
     fn per_realization(&self, terms: &TermSet, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
-        let init = || (Scratch::default(), vec![0.0; terms.terms.len()]);
-        let one = |(scratch, sums): &mut (Scratch, Vec<f64>),
-                   (set, diagonal): (&PointSet, &f64)| {
-            terms.layer_sums.power_sums(set, shear, scratch, sums);
-            let power = terms
-                .terms
-                .iter()
-                .zip(sums.iter())
-                .map(|(t, p)| t.coefficient * p);
-            crate::sum::sum(power.chain([-diagonal]))
-        };
-        let sets = uv.sets.iter().zip(&terms.weighted_diagonal);
+        let one =
+            |scratch: &mut Scratch, sums: &mut Vec<f64>, (set, diagonal): (&PointSet, &f64)| {
+                terms.layer_sums.power_sums(set, shear, scratch, sums);
+                let power = terms
+                    .terms
+                    .iter()
+                    .zip(sums.iter())
+                    .map(|(t, p)| t.coefficient * p);
+                crate::sum::sum(power.chain([-diagonal]))
+            };
+        let sums = || vec![0.0; terms.terms.len()];
         if terms.layer_sums.transforms() {
-            let mut buffers = init();
-            return sets.map(|s| one(&mut buffers, s)).collect();
+            // A poisoned lock only means a panic elsewhere mid-evaluation;
+            // the buffers are overwritten before use.
+            let mut scratch = terms
+                .transform_scratch
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            let mut sums = sums();
+            return uv
+                .sets
+                .iter()
+                .zip(&terms.weighted_diagonal)
+                .map(|s| one(&mut scratch, &mut sums, s))
+                .collect();
         }
         uv.sets
             .par_iter()
             .zip(&terms.weighted_diagonal)
-            .map_init(init, one)
+            .map_init(
+                || (Scratch::default(), sums()),
+                |(scratch, sums), s| one(scratch, sums, s),
+            )
             .collect()
     }
 
