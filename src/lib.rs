@@ -48,6 +48,7 @@ pub mod rng;
 pub mod samplers;
 pub mod scene;
 pub mod source;
+pub mod spec_params;
 pub mod spectrum;
 pub mod square;
 pub mod sum;

@@ -309,14 +309,14 @@ pub fn split_spec<'a>(
     let Some((name, rest)) = name.split_once(':') else {
         return Ok((name, params.to_vec()));
     };
-    let mut all = Vec::new();
-    for part in rest.split(',').filter(|p| !p.is_empty()) {
-        let (k, v) = part.split_once('=').ok_or_else(|| SamplerError::Syntax {
+    let mut all: Vec<(String, String)> = crate::spec_params::key_values(rest)
+        .map_err(|reason| SamplerError::Syntax {
             spec: format!("{name}:{rest}"),
-            part: part.to_string(),
-        })?;
-        all.push((k.trim().to_string(), v.trim().to_string()));
-    }
+            reason,
+        })?
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
     if let Some(e) = repeated(&all) {
         return Err(e);
     }

@@ -952,6 +952,49 @@ fn a_closed_standard_output_is_not_an_error() {
     }
 }
 
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_standard_output_is_an_error_and_no_file_appears() {
+    // `varspec … > /dev/full`: print! panicked with a backtrace (exit 101)
+    // and left the staged temporaries of the command's files behind.
+    let dir = temp_dir("full-stdout");
+    let table = dir.join("t.csv");
+    for args in [
+        vec!["integrands", "--list"],
+        vec![
+            "tables",
+            "--sampler",
+            "jitter",
+            "-n",
+            "64",
+            "--format",
+            "csv",
+            "-o",
+            table.to_str().unwrap(),
+        ],
+    ] {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .expect("Linux has /dev/full");
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_varspec"))
+            .args(&args)
+            .stdout(full)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert!(
+            err.contains("error: cannot write to standard output: No space left on device")
+                && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert!(left.is_empty(), "files left: {left:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A CSV file's header and records, read by the csv crate.
 fn csv_table(path: &std::path::Path) -> (Vec<String>, Vec<csv::StringRecord>) {
     let mut r = csv::Reader::from_path(path).unwrap();

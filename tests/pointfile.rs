@@ -71,6 +71,30 @@ fn negative_zero_reads_as_zero() {
 }
 
 #[test]
+fn bytes_that_are_not_utf8_are_named_with_their_line() {
+    // Was the csv crate's debug dump: `Utf8 { pos: Some(Position { .. }) }`.
+    for (bytes, line) in [
+        (&b"x0,x1\n0.1,0.2\n\xff,0.5\n"[..], 3),
+        (b"\xff0.1 0.2\n", 1),
+        (b"0.1 0.2\n0.3 \xff\n", 2),
+    ] {
+        match parse_point_sets(bytes, Path::new("in.csv")) {
+            Err(
+                e @ PointFileError::Line {
+                    problem: LineProblem::NotUtf8,
+                    ..
+                },
+            ) => assert!(
+                e.to_string()
+                    .starts_with(&format!("in.csv:{line}: not UTF-8")),
+                "{e}"
+            ),
+            other => panic!("{bytes:?}: {other:?}"),
+        }
+    }
+}
+
+#[test]
 fn every_malformed_input_names_its_line() {
     type Case = (&'static str, usize, fn(&LineProblem) -> bool, &'static str);
     let cases: Vec<Case> = vec![

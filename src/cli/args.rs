@@ -95,11 +95,56 @@ impl DrawArgs {
 
 /// Checks every output before any work starts (a missing folder, a folder
 /// given as a file), so a long run does not end in a failed write.
+///
+/// # Errors
+/// The first output that cannot be written, or the same file given as two
+/// outputs (one would silently replace the other).
 pub fn check_outputs<'a>(
     paths: impl IntoIterator<Item = Option<&'a std::path::Path>>,
 ) -> anyhow::Result<()> {
-    for path in paths.into_iter().flatten() {
+    check_outputs_beside(paths, [])
+}
+
+/// [`check_outputs`], and that no output is one of the command's `inputs`
+/// (writing it would replace the file being read).
+///
+/// # Errors
+/// As [`check_outputs`], or an output that is an input.
+pub fn check_outputs_beside<'a>(
+    outputs: impl IntoIterator<Item = Option<&'a std::path::Path>>,
+    inputs: impl IntoIterator<Item = Option<&'a std::path::Path>>,
+) -> anyhow::Result<()> {
+    let inputs: Vec<_> = inputs
+        .into_iter()
+        .flatten()
+        .filter_map(|p| varspec::io::file_identity(p).map(|id| (p, id)))
+        .collect();
+    let mut seen: Vec<(&std::path::Path, std::path::PathBuf)> = Vec::new();
+    for path in outputs.into_iter().flatten() {
         varspec::io::check_output(path)?;
+        let Some(id) = varspec::io::file_identity(path) else {
+            continue;
+        };
+        let named = |other: &std::path::Path| {
+            if other == path {
+                format!("{}", path.display())
+            } else {
+                format!("{} (the same file as {})", path.display(), other.display())
+            }
+        };
+        if let Some((input, _)) = inputs.iter().find(|(_, i)| *i == id) {
+            bail!(
+                "{} is both an input and an output of this command: writing it would replace what is read; name another output file",
+                named(input)
+            );
+        }
+        if let Some((other, _)) = seen.iter().find(|(_, s)| *s == id) {
+            bail!(
+                "{} is given as two outputs: one would replace the other; give each output its own file",
+                named(other)
+            );
+        }
+        seen.push((path, id));
     }
     Ok(())
 }
@@ -134,12 +179,20 @@ fn parse_whole(text: &str) -> Result<u64, NotWhole> {
 /// fractional and too large values are refused naming what was typed
 /// (clap's own parser says "invalid digit found in string").
 pub fn whole<T: TryFrom<u64>>(text: &str) -> Result<T, String> {
+    whole_at_least::<0, T>(text)
+}
+
+/// A whole number of at least `MIN`, as [`whole`].
+pub fn whole_at_least<const MIN: u64, T: TryFrom<u64>>(text: &str) -> Result<T, String> {
     let value = parse_whole(text).map_err(|e| match e {
-        NotWhole::Negative => format!("`{text}` is negative; expected a whole number >= 0"),
+        NotWhole::Negative => format!("`{text}` is negative; expected a whole number >= {MIN}"),
         NotWhole::Fraction => format!("`{text}` is not a whole number"),
         NotWhole::TooLarge => format!("`{text}` is larger than 2^64 - 1"),
         NotWhole::Text => format!("`{text}` is not a whole number (write e.g. 16 or 1e3)"),
     })?;
+    if value < MIN {
+        return Err(format!("`{text}`: expected a whole number >= {MIN}"));
+    }
     T::try_from(value).map_err(|_| format!("`{text}` is too large for this option"))
 }
 

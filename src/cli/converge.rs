@@ -41,8 +41,9 @@ pub struct Args {
     /// mean squared error over it, by brute force over the members.
     #[arg(long)]
     family: Option<String>,
-    /// Members of the family sample (with --family).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
+    /// Members of the family sample (with --family; at least 2, for the
+    /// standard error).
+    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
     members: usize,
     /// Comma-separated N values (constrained samplers use the nearest valid N).
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_hyphen_values = true, value_delimiter = ',', required = true)]

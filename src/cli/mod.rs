@@ -21,7 +21,7 @@ mod tables;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// Design Monte Carlo sample patterns by the integration error they produce.
 #[derive(Parser)]
@@ -29,6 +29,24 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+}
+
+/// The command line's grammar: every option that takes a value takes a
+/// negative number too (`--range -1` reaches the option's own check, which
+/// says what the range must be, instead of clap's "unexpected argument").
+fn grammar() -> clap::Command {
+    fn negative_values(command: clap::Command) -> clap::Command {
+        command
+            .mut_args(|a| {
+                if a.get_action().takes_values() {
+                    a.allow_negative_numbers(true)
+                } else {
+                    a
+                }
+            })
+            .mut_subcommands(negative_values)
+    }
+    negative_values(Cli::command())
 }
 
 #[derive(Subcommand)]
@@ -82,25 +100,24 @@ enum Command {
 
 /// Parses the arguments, runs the subcommand, reports any error on stderr.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
-    // `println!` panics when standard output was closed early (`varspec …
-    // | head`): that is not an error; say nothing and stop the command
-    // there, keeping what it wrote.
+    let cli = Cli::from_arg_matches(&grammar().get_matches()).unwrap_or_else(|e| e.exit());
+    // `println!` panics when standard output cannot be written. Closed
+    // early (`varspec … | head`) is not an error: say nothing and stop the
+    // command there, keeping what it wrote. Any other failure (a full
+    // disk) is one: an error line, and no file output appears.
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        if !is_stdout_closed(info.payload()) {
+        if stdout_failure(info.payload()).is_none() {
             default_hook(info);
         }
     }));
     // A command's outputs appear together or not at all.
     let result = varspec::io::all_or_nothing(|| {
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli.command))).unwrap_or_else(
-            |payload| {
-                if is_stdout_closed(payload.as_ref()) {
-                    Ok(())
-                } else {
-                    std::panic::resume_unwind(payload)
-                }
+            |payload| match stdout_failure(payload.as_ref()) {
+                Some(reason) if reason.contains("Broken pipe") => Ok(()),
+                Some(reason) => Err(anyhow::anyhow!("cannot write to standard output: {reason}")),
+                None => std::panic::resume_unwind(payload),
             },
         )
     });
@@ -114,14 +131,14 @@ pub fn main() -> ExitCode {
     }
 }
 
-/// True for the panic of `print!` on a closed standard output.
-fn is_stdout_closed(payload: &(dyn std::any::Any + Send)) -> bool {
+/// The reason in the panic of `print!` when standard output cannot be
+/// written (`None` for any other panic).
+fn stdout_failure(payload: &(dyn std::any::Any + Send)) -> Option<&str> {
     let text = payload
         .downcast_ref::<String>()
         .map(String::as_str)
-        .or_else(|| payload.downcast_ref::<&str>().copied())
-        .unwrap_or("");
-    text.starts_with("failed printing to stdout") && text.contains("Broken pipe")
+        .or_else(|| payload.downcast_ref::<&str>().copied())?;
+    text.strip_prefix("failed printing to stdout: ")
 }
 
 /// Runs one subcommand.
@@ -139,13 +156,7 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Experiment(a) => experiment::run(a),
         Command::Merge(a) => experiment::merge(a),
         Command::Completions { shell } => {
-            use clap::CommandFactory;
-            clap_complete::generate(
-                shell,
-                &mut Cli::command(),
-                "varspec",
-                &mut std::io::stdout(),
-            );
+            clap_complete::generate(shell, &mut grammar(), "varspec", &mut std::io::stdout());
             Ok(())
         }
         Command::Optimize(c) => optimize::run(c),

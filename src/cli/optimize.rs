@@ -96,8 +96,9 @@ pub struct PointsArgs {
     /// `--sampler` as in every other command.
     #[arg(long, visible_alias = "sampler")]
     init: Option<String>,
-    /// Square: family members the result and the classic samplers are scored on.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
+    /// Square: family members the result and the classic samplers are scored
+    /// on (at least 2, for the standard error).
+    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
     members: usize,
     /// Square: seed of the scoring members (the descent draws its own members
     /// from --seed on other streams).
@@ -179,12 +180,18 @@ enum DomainArg {
 }
 
 fn points(a: PointsArgs) -> anyhow::Result<()> {
-    args::check_outputs([
-        Some(a.output.as_path()),
-        a.report.as_deref(),
-        a.curve.as_deref(),
-        a.curve_png.as_deref(),
-    ])?;
+    args::check_outputs_beside(
+        [
+            Some(a.output.as_path()),
+            a.report.as_deref(),
+            a.curve.as_deref(),
+            a.curve_png.as_deref(),
+        ],
+        [a.init
+            .as_deref()
+            .map(std::path::Path::new)
+            .filter(|p| p.is_file())],
+    )?;
     if a.sets == 0 {
         bail!("--sets must be at least 1");
     }

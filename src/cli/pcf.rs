@@ -33,7 +33,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
+    super::args::check_outputs_beside([a.csv.as_deref(), a.png.as_deref()], [a.source.file()])?;
     if !(a.range.is_finite() && a.range > 0.0) {
         bail!(
             "--range {:?}: the largest radius, in units of the packing distance r_max, must be a positive number (default 2.5)",

@@ -40,8 +40,9 @@ pub struct Args {
     /// mean squared error over it.
     #[arg(long)]
     family: Option<String>,
-    /// Members of the family sample (with --family).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
+    /// Members of the family sample (with --family; at least 2, for the
+    /// standard error).
+    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
     members: usize,
     /// Which predictor(s) to run.
     #[arg(long, value_enum, default_value_t = MethodArg::All)]

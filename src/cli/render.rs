@@ -143,7 +143,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }
         }
     };
-    args::check_outputs(std::iter::once(a.output.as_deref()).chain(a.side_outputs()))?;
+    args::check_outputs_beside(
+        std::iter::once(a.output.as_deref()).chain(a.side_outputs()),
+        [
+            a.reference.as_deref(),
+            Some(std::path::Path::new(&a.scene)).filter(|p| p.is_file()),
+        ],
+    )?;
     let scene = Scene::load(&a.scene)?;
     // Every thread holds one pixel's set (and its sheared copy) at a time.
     varspec::memory::check(

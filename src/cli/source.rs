@@ -52,6 +52,11 @@ impl SourceArgs {
         self.points.is_some() || self.points_flag.is_some() || self.sampler.is_some()
     }
 
+    /// The point-set file given, if any (an input no output may replace).
+    pub fn file(&self) -> Option<&std::path::Path> {
+        self.points.as_deref().or(self.points_flag.as_deref())
+    }
+
     /// The plane given with --dims, checked to be two distinct indices
     /// (what the spectrum of a 4D integrand is drawn on).
     pub fn plane(&self) -> anyhow::Result<Option<[usize; 2]>> {

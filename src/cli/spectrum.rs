@@ -108,13 +108,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.res
         );
     }
-    super::args::check_outputs([
-        a.csv.as_deref(),
-        a.npy.as_deref(),
-        a.radial.as_deref(),
-        a.png.as_deref(),
-        a.radial_png.as_deref(),
-    ])?;
+    super::args::check_outputs_beside(
+        [
+            a.csv.as_deref(),
+            a.npy.as_deref(),
+            a.radial.as_deref(),
+            a.png.as_deref(),
+            a.radial_png.as_deref(),
+        ],
+        [a.source.file()],
+    )?;
     let freqs = FrequencyBox::from_resolution(2, a.res);
     let plane = a.source.plane()?;
     let axes = match plane {

@@ -66,7 +66,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    super::args::check_outputs([Some(a.output.as_path())])?;
+    super::args::check_outputs_beside([Some(a.output.as_path())], [a.from.as_deref()])?;
     if let Some(shard) = a.shard {
         return draw_table_shard(&a, shard);
     }

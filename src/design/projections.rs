@@ -102,7 +102,7 @@ pub fn design_projections(
     let init = registry::build(&init_name, r.n, Some(4), &[])?;
     let options = AdamOptions {
         iters: r.iters.unwrap_or(1000),
-        rel_tol: r.rel_tol.unwrap_or(1e-4),
+        rel_tol: AdamOptions::checked_rel_tol(r.rel_tol.unwrap_or(1e-4))?,
         step: 0.05,
         final_step: 0.002,
         score_every: 1,

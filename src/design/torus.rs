@@ -171,7 +171,7 @@ impl TorusPlan {
             options.tolerance = t;
         }
         if let Some(t) = r.rel_tol {
-            options.rel_tol = t;
+            options.rel_tol = crate::optimize::adam::AdamOptions::checked_rel_tol(t)?;
         }
         if let Some(u) = r.upsampling {
             options.upsampling = u;

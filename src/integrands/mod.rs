@@ -107,13 +107,13 @@ pub enum IntegrandError {
         /// Its keys.
         known: String,
     },
-    /// Malformed `key=value` text.
-    #[error("integrand spec `{spec}`: `{part}` is not key=value")]
+    /// A malformed `key=value` list.
+    #[error("integrand spec `{spec}`: {reason}")]
     Syntax {
         /// The whole spec.
         spec: String,
-        /// The offending part.
-        part: String,
+        /// What is wrong with its list.
+        reason: crate::spec_params::ParamListError,
     },
     /// A key given twice.
     #[error("integrand spec `{spec}`: `{key}` is given twice (each parameter once)")]

@@ -202,12 +202,11 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
                     .join(", "),
             })?;
     let mut pairs = Vec::new();
-    for part in rest.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        let (k, v) = part.split_once('=').ok_or_else(|| IntegrandError::Syntax {
-            spec: spec.to_string(),
-            part: part.to_string(),
-        })?;
-        let k = k.trim();
+    let list = crate::spec_params::key_values(rest).map_err(|reason| IntegrandError::Syntax {
+        spec: spec.to_string(),
+        reason,
+    })?;
+    for (k, v) in list {
         if !info.params.iter().any(|p| p.0 == k) {
             return Err(IntegrandError::UnknownKey {
                 integrand: info.name,
@@ -226,7 +225,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
                 key: k.to_string(),
             });
         }
-        pairs.push((k.to_string(), v.trim().to_string()));
+        pairs.push((k.to_string(), v.to_string()));
     }
     let p = Params { info, pairs };
     let unit = |v: f64| v > 0.0 && v <= 1.0;

@@ -275,6 +275,23 @@ pub fn check_output(path: &Path) -> Result<(), WriteError> {
 
 /// Follows symbolic links (up to 32) to the path that will be written; a
 /// dangling link resolves to where its target would be.
+/// The file `path` names, to tell whether two paths are one file: links
+/// resolved and the folder made canonical. `None` for a device, FIFO or
+/// socket (`-o /dev/null` may be named twice) and for a path whose folder
+/// does not resolve (its write is refused on its own).
+pub fn file_identity(path: &Path) -> Option<PathBuf> {
+    let target = resolve_links(path).ok()?;
+    if fs::metadata(&target).is_ok_and(|m| !m.is_file()) {
+        return None;
+    }
+    let name = target.file_name()?;
+    let dir = match target.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(dir) => fs::canonicalize(dir).ok()?,
+        None => std::env::current_dir().ok()?,
+    };
+    Some(dir.join(name))
+}
+
 fn resolve_links(path: &Path) -> io::Result<PathBuf> {
     let mut current = path.to_path_buf();
     for _ in 0..32 {

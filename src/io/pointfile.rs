@@ -113,6 +113,8 @@ pub enum LineProblem {
         /// Fields found.
         found: usize,
     },
+    /// Bytes that are not UTF-8 text.
+    NotUtf8,
     /// A `set` value that does not continue 0, 1, 2, ….
     SetNumber {
         /// The set being read.
@@ -145,6 +147,7 @@ impl fmt::Display for LineProblem {
             LineProblem::Ragged { expected, found } => {
                 write!(f, "{found} fields where every row has {expected}")
             }
+            LineProblem::NotUtf8 => write!(f, "not UTF-8 text (is this a point-set file?)"),
             LineProblem::SetNumber {
                 current: None,
                 text,
@@ -259,7 +262,14 @@ pub fn parse_point_sets<R: BufRead>(
     let mut line = 0;
     loop {
         first.clear();
-        if reader.read_line(&mut first).map_err(io)? == 0 {
+        let read = reader.read_line(&mut first).map_err(|e| {
+            if is_not_utf8(&e) {
+                at(line + 1)(LineProblem::NotUtf8)
+            } else {
+                io(e)
+            }
+        })?;
+        if read == 0 {
             return parser.finish();
         }
         line += 1;
@@ -280,9 +290,14 @@ pub fn parse_point_sets<R: BufRead>(
             .from_reader(reader);
         let mut record = csv::StringRecord::new();
         loop {
-            let more = csv
-                .read_record(&mut record)
-                .map_err(|e| io(csv_io_error(e)))?;
+            let more = csv.read_record(&mut record).map_err(|e| match e.kind() {
+                csv::ErrorKind::Utf8 { pos, .. } => PointFileError::Line {
+                    path: path.into(),
+                    line: line + pos.as_ref().map_or(1, |p| p.line() as usize),
+                    problem: LineProblem::NotUtf8,
+                },
+                _ => io(csv_io_error(e)),
+            })?;
             if !more {
                 break;
             }
@@ -298,10 +313,22 @@ pub fn parse_point_sets<R: BufRead>(
     parser.line(text).map_err(at(line))?;
     for next in reader.lines() {
         line += 1;
-        let next = next.map_err(io)?;
+        let next = next.map_err(|e| {
+            if is_not_utf8(&e) {
+                at(line)(LineProblem::NotUtf8)
+            } else {
+                io(e)
+            }
+        })?;
         parser.line(next.trim_end_matches('\r')).map_err(at(line))?;
     }
     parser.finish()
+}
+
+/// True for the error of `read_line` on bytes that are not UTF-8: std's bare
+/// `InvalidData` (the long-line refusal below carries its own message).
+fn is_not_utf8(e: &io::Error) -> bool {
+    e.kind() == io::ErrorKind::InvalidData && e.get_ref().is_none()
 }
 
 /// A reader that refuses lines longer than [`MAX_LINE`] bytes.

@@ -68,6 +68,24 @@ pub struct AdamOptions {
     pub floor: f64,
 }
 
+impl AdamOptions {
+    /// `rel_tol` checked: a finite relative improvement in [0, 1) (0: never
+    /// stop early; NaN or a negative value would silently never stop, 1 or
+    /// more would stop at the first check).
+    ///
+    /// # Errors
+    /// [`OptimizeError::Option`] naming the value.
+    pub fn checked_rel_tol(rel_tol: f64) -> Result<f64, super::OptimizeError> {
+        if (0.0..1.0).contains(&rel_tol) {
+            Ok(rel_tol)
+        } else {
+            Err(super::OptimizeError::Option(format!(
+                "--rel-tol {rel_tol}: the relative improvement over 50 iterations below which the descent stops must be in [0, 1) (0: never stop early)"
+            )))
+        }
+    }
+}
+
 /// Why a descent stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -124,13 +124,13 @@ pub enum SamplerError {
         /// Requested d.
         dim: usize,
     },
-    /// Malformed `name:key=value,...` text.
-    #[error("sampler `{spec}`: `{part}` is not key=value")]
+    /// A malformed `name:key=value,...` list.
+    #[error("sampler `{spec}`: {reason}")]
     Syntax {
         /// The whole spec.
         spec: String,
-        /// The offending part.
-        part: String,
+        /// What is wrong with its list.
+        reason: crate::spec_params::ParamListError,
     },
     /// The same parameter given twice in one place (the spec's shorthand,
     /// or the --param list).

@@ -99,11 +99,10 @@ impl PixelIntegrand {
             return Err(fail("no scene name".into()));
         }
         let (mut px, mut py) = (None, None);
-        for part in params.split(',') {
-            let (key, value) = part
-                .split_once('=')
-                .ok_or_else(|| fail(format!("`{part}` is not key=value")))?;
-            let slot = match key.trim() {
+        for (key, value) in
+            crate::spec_params::key_values(params).map_err(|e| fail(e.to_string()))?
+        {
+            let slot = match key {
                 "px" => &mut px,
                 "py" => &mut py,
                 other => {
@@ -115,7 +114,7 @@ impl PixelIntegrand {
             if slot.is_some() {
                 return Err(fail(format!("`{key}` given twice")));
             }
-            let v: usize = value.trim().parse().map_err(|_| {
+            let v: usize = value.parse().map_err(|_| {
                 fail(format!(
                     "{key} = {value}: a pixel index, a whole number >= 0"
                 ))

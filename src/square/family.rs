@@ -86,18 +86,17 @@ impl Family {
         if name == "file" {
             return read_list(rest).map_err(fail);
         }
-        let mut pairs = Vec::new();
-        for part in rest.split(',').filter(|p| !p.trim().is_empty()) {
-            let (k, v) = part
-                .split_once('=')
-                .ok_or_else(|| fail(format!("`{part}` is not key=value")))?;
+        let mut pairs: Vec<(String, f64)> = Vec::new();
+        for (k, v) in crate::spec_params::key_values(rest).map_err(|e| fail(e.to_string()))? {
             let value: f64 = v
-                .trim()
                 .parse()
                 .ok()
                 .filter(|x: &f64| x.is_finite())
                 .ok_or_else(|| fail(format!("{k}={v} is not a number")))?;
-            pairs.push((k.trim().to_string(), value));
+            if pairs.iter().any(|(seen, _)| seen == k) {
+                return Err(fail(format!("`{k}` is given twice (each parameter once)")));
+            }
+            pairs.push((k.to_string(), value));
         }
         let keys: &[(&str, f64)] = match name {
             "gaussians" => &[("vmin", 0.01), ("vmax", 1.0)],
@@ -127,7 +126,6 @@ impl Family {
         let get = |key: &str| {
             pairs
                 .iter()
-                .rev()
                 .find(|(k, _)| k == key)
                 .map(|p| p.1)
                 .or_else(|| keys.iter().find(|k| k.0 == key).map(|k| k.1))

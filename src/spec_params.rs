@@ -1,0 +1,88 @@
+//! The `key=value,key=value` parameter lists of specs: a sampler's
+//! `padded:xy=cmj,uv=jitter`, an integrand's `disk:r=0.3,cx=0.2`, a family's
+//! `disks:rmin=0.1`, a scene pixel's `scene:dof,px=3,py=4`. One parser, so
+//! every spec refuses a malformed list the same way: an empty parameter
+//! (`a=1,,b=2`, a trailing comma) is a typo, never skipped.
+
+/// Why a parameter list was refused.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ParamListError {
+    /// Nothing between two commas, or before or after the list's ends.
+    #[error("parameter {position} of `{list}` is empty (two commas in a row or a comma at an end)")]
+    Empty {
+        /// The list.
+        list: String,
+        /// Its 1-based position.
+        position: usize,
+    },
+    /// A parameter without `=`, or with nothing before it.
+    #[error("`{part}` is not key=value")]
+    NotKeyValue {
+        /// The parameter.
+        part: String,
+    },
+}
+
+/// The `(key, value)` pairs of `list`, each trimmed, in order; a blank list
+/// has none. Values may hold `=` and `:` (a sampler spec as a value).
+///
+/// # Errors
+/// [`ParamListError`] naming the empty or malformed parameter.
+pub fn key_values(list: &str) -> Result<Vec<(&str, &str)>, ParamListError> {
+    if list.trim().is_empty() {
+        return Ok(Vec::new());
+    }
+    list.split(',')
+        .enumerate()
+        .map(|(i, part)| {
+            if part.trim().is_empty() {
+                return Err(ParamListError::Empty {
+                    list: list.to_string(),
+                    position: i + 1,
+                });
+            }
+            match part.split_once('=') {
+                Some((k, v)) if !k.trim().is_empty() => Ok((k.trim(), v.trim())),
+                _ => Err(ParamListError::NotKeyValue {
+                    part: part.trim().to_string(),
+                }),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pairs_in_order_trimmed() {
+        assert_eq!(
+            key_values(" r = 0.3 ,uv=sobol:scramble=hash").unwrap(),
+            vec![("r", "0.3"), ("uv", "sobol:scramble=hash")]
+        );
+        assert_eq!(key_values("").unwrap(), Vec::<(&str, &str)>::new());
+        assert_eq!(key_values("  ").unwrap(), Vec::<(&str, &str)>::new());
+    }
+
+    #[test]
+    fn empty_and_malformed_parameters_are_refused() {
+        for (list, position) in [("a=1,,b=2", 2), ("a=1,", 2), (",a=1", 1), ("a=1, ,b=2", 2)] {
+            assert_eq!(
+                key_values(list),
+                Err(ParamListError::Empty {
+                    list: list.into(),
+                    position
+                }),
+                "{list}"
+            );
+        }
+        for (list, part) in [("a=1,b", "b"), ("=3", "=3"), ("a=1, =2", "=2")] {
+            assert_eq!(
+                key_values(list),
+                Err(ParamListError::NotKeyValue { part: part.into() }),
+                "{list}"
+            );
+        }
+    }
+}
