@@ -6,7 +6,8 @@
 //! CCVT-like blue noise, starting from uniform random points; on the square
 //! (`domain=square`) it is a sum of family MSEs of the unshifted estimator
 //! ([`crate::square::design`]), by default half-planes + Gaussians + blue
-//! repulsion, starting from jitter. Deterministic for a seed like every
+//! repulsion, starting from jitter (CMJ where N is not a square).
+//! Deterministic for a seed like every
 //! sampler.
 
 use crate::optimize::{AdamOptions, DescentOptions, PointOptimizer, Target};
@@ -85,8 +86,13 @@ pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> 
             if let Some(i) = iters {
                 options.iters = i;
             }
+            // Jitter needs N = m²; CMJ stratifies any N the same way.
+            let start = match c.build_other("jitter", c.n, Some(2), &[]) {
+                Err(SamplerError::Count { .. }) => c.build_other("cmj", c.n, Some(2), &[])?,
+                other => other?,
+            };
             How::Square {
-                start: c.build_other("jitter", c.n, Some(2), &[])?,
+                start,
                 terms,
                 options,
             }

@@ -2,6 +2,10 @@
 
 use crate::rng::PREV_ONE;
 
+/// The largest factor between a density λ given for sets and their mean
+/// count that [`PointSet::all_with_density`] accepts.
+pub const DENSITY_SLACK: f64 = 2.0;
+
 /// A violated [`PointSet`] invariant, naming the point and coordinate.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PointSetError {
@@ -49,6 +53,20 @@ pub enum PointSetError {
     /// A point-process density that is not a positive finite number.
     #[error("density {0} is not a positive finite number (the expected points per unit volume)")]
     Density(f64),
+    /// A density far from the sets' own mean count: their estimates would
+    /// be off by that factor.
+    #[error(
+        "density {density:e}: the sets hold {mean_count:.1} points on average, and a density is the expected count per unit volume; \
+         the estimate Σ f/λ would be {factor:.3e} times the integral (give λ within a factor {DENSITY_SLACK} of the mean count)"
+    )]
+    DensityFarFromCount {
+        /// The density given.
+        density: f64,
+        /// The sets' mean number of points.
+        mean_count: f64,
+        /// mean count / density.
+        factor: f64,
+    },
     /// A shift vector of the wrong length or with values outside [0,1).
     #[error("shift {shift:?} is not a vector of {dim} values in [0, 1)")]
     Shift {
@@ -153,6 +171,36 @@ impl PointSet {
         }
         self.density = Some(density);
         Ok(self)
+    }
+
+    /// `sets` as realizations of a process of density λ, checked against
+    /// their own mean count: the estimator Σ f/λ is unbiased only when λ
+    /// is the expected count, so a λ off by more than [`DENSITY_SLACK`]
+    /// from the mean count is a mistake (a random-count process's counts
+    /// scatter by ~√λ, far less).
+    ///
+    /// # Errors
+    /// [`PointSetError::Density`] for a λ that is not positive and finite,
+    /// [`PointSetError::DensityFarFromCount`] for one far from the counts.
+    pub fn all_with_density(
+        sets: Vec<PointSet>,
+        density: f64,
+    ) -> Result<Vec<PointSet>, PointSetError> {
+        let sets = sets
+            .into_iter()
+            .map(|s| s.with_density(density))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mean_count =
+            sets.iter().map(|s| s.len() as f64).sum::<f64>() / sets.len().max(1) as f64;
+        let factor = mean_count / density;
+        if !(1.0 / DENSITY_SLACK..=DENSITY_SLACK).contains(&factor) {
+            return Err(PointSetError::DensityFarFromCount {
+                density,
+                mean_count,
+                factor,
+            });
+        }
+        Ok(sets)
     }
 
     /// The density λ of the process that drew the set, if its number of

@@ -356,6 +356,17 @@ pub fn build(
         .find(|(k, _)| !info.params.iter().any(|p| p.key == k))
     {
         let known = info.params.iter().map(|p| p.key).collect::<Vec<_>>();
+        // `padded:uv=poisson-disk:radius=0.5,max-trials=9` splits at every
+        // comma: the nested spec's second parameter lands here.
+        let hint = params
+            .iter()
+            .find(|(_, v)| v.contains(':'))
+            .map(|(k, v)| {
+                format!(
+                    " (if `{key}` belongs to `{k}={v}`: the shorthand splits at every comma, so give a nested spec with several parameters as --param '{k}={v},{key}=...')"
+                )
+            })
+            .unwrap_or_default();
         return Err(SamplerError::UnknownParam {
             sampler,
             key: key.clone(),
@@ -364,6 +375,7 @@ pub fn build(
             } else {
                 known.join(", ")
             },
+            hint,
         });
     }
     let config = Config::new(sampler, n, dim, params.to_vec(), info.params, build);

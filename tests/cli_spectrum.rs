@@ -151,11 +151,11 @@ fn bad_spectrum_requests_are_clear_errors() {
         ),
         (
             vec!["spectrum", s(&four), "--dims", "0,2", "--tol", "0"],
-            "tolerance 0 is outside",
+            "`0`: a relative tolerance is a number from 1e-14 to 0.1",
         ),
         (
             vec!["spectrum", s(&four), "--dims", "0,2", "--tol", "-1e-6"],
-            "outside",
+            "`-1e-6`: a relative tolerance is a number from 1e-14 to 0.1",
         ),
         (
             vec!["spectrum", s(&four), "--dims", "0,2", "--res", "200000"],

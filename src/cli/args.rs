@@ -28,6 +28,28 @@ pub fn dims(text: &str, count: usize) -> anyhow::Result<Vec<usize>> {
     Ok(dims)
 }
 
+/// A relative NUFFT tolerance: a number in [1e-14, 0.1] (the range every
+/// plan accepts), checked when given even where a method does not use it.
+pub fn tolerance(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|t| (1e-14..=0.1).contains(t))
+        .ok_or_else(|| format!("`{text}`: a relative tolerance is a number from 1e-14 to 0.1"))
+}
+
+/// Family members scored when --members is not given.
+pub const DEFAULT_MEMBERS: usize = 1024;
+
+/// --members checked against --family: it only applies there.
+pub fn family_members(members: Option<usize>, family: Option<&str>) -> anyhow::Result<usize> {
+    match (members, family) {
+        (Some(_), None) => {
+            bail!("--members applies to --family (a family's members), not to --integrand")
+        }
+        (m, _) => Ok(m.unwrap_or(DEFAULT_MEMBERS)),
+    }
+}
+
 /// Realizations drawn when --sets is not given, the same in every command
 /// that draws sets of a sampler (sample, predict, converge, spectrum, pcf,
 /// optimize points, tables).

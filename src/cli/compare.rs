@@ -52,8 +52,10 @@ struct Row {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    if a.n < 2 || a.sets == 0 {
-        bail!("compare needs at least 2 points (-n) and 1 set (--sets)");
+    // At N = 2 the m² samplers' nearest valid N is 1, which has no
+    // nearest neighbour.
+    if a.n < 3 || a.sets == 0 {
+        bail!("compare needs at least 3 points (-n) and 1 set (--sets)");
     }
     std::fs::create_dir_all(&a.output)
         .with_context(|| format!("cannot create folder {}", a.output.display()))?;
@@ -97,6 +99,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         println!(
             "{:<16} {:>6} {:>10.2} {:>8.3} {:>8.3}",
             r.name, r.n, r.mpts_per_s, r.min_rel, r.mean_rel
+        );
+    }
+    let moved: Vec<String> = rows
+        .iter()
+        .filter(|r| r.n != a.n)
+        .map(|r| format!("{} N = {}", r.name, r.n))
+        .collect();
+    if !moved.is_empty() {
+        println!(
+            "N: {} (the nearest N their structure allows to -n {})",
+            moved.join(", "),
+            a.n
         );
     }
     println!(

@@ -41,10 +41,10 @@ pub struct Args {
     /// mean squared error over it, by brute force over the members.
     #[arg(long)]
     family: Option<String>,
-    /// Members of the family sample (with --family; at least 2, for the
-    /// standard error).
-    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
-    members: usize,
+    /// Members of the family sample (with --family; default 1024; at least
+    /// 2, for the standard error).
+    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
+    members: Option<usize>,
     /// Comma-separated N values (constrained samplers use the nearest valid N).
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_hyphen_values = true, value_delimiter = ',', required = true)]
     ns: Vec<usize>,
@@ -86,8 +86,9 @@ enum Subject {
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
     a.draw.check_results_memory()?;
+    let members = super::args::family_members(a.members, a.family.as_deref())?;
     if a.family.is_some() {
-        varspec::square::mse::check_family_memory(a.members, a.draw.sets())?;
+        varspec::square::mse::check_family_memory(members, a.draw.sets())?;
     }
     let subject = match (&a.integrand, &a.family) {
         (Some(spec), _) => Subject::Torus(integrands::parse(spec)?),
@@ -142,7 +143,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     a.draw.sets(),
                     &|| {},
                 )?;
-                let e = family_mse(&sets, family, a.members, a.draw.seed());
+                let e = family_mse(&sets, family, members, a.draw.seed());
                 (e.mse, e.stderr, 0.0)
             }
             (Subject::Torus(f), method) => {

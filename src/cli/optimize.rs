@@ -111,7 +111,7 @@ pub struct PointsArgs {
     res: Option<usize>,
     /// NUFFT tolerance of the loss and gradient (the speed/accuracy knob;
     /// default 1e-6, as the blue-noise sampler).
-    #[arg(long)]
+    #[arg(long, value_parser = args::tolerance)]
     tol: Option<f64>,
     /// Stop when the loss improves by less than this, relatively, over 50
     /// iterations (default 1e-3 for blue-noise targets: the same variance on

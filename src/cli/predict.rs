@@ -40,10 +40,10 @@ pub struct Args {
     /// mean squared error over it.
     #[arg(long)]
     family: Option<String>,
-    /// Members of the family sample (with --family; at least 2, for the
-    /// standard error).
-    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
-    members: usize,
+    /// Members of the family sample (with --family; default 1024; at least
+    /// 2, for the standard error).
+    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
+    members: Option<usize>,
     /// Which predictor(s) to run.
     #[arg(long, value_enum, default_value_t = MethodArg::All)]
     method: MethodArg,
@@ -54,7 +54,7 @@ pub struct Args {
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// NUFFT tolerance of the Fourier predictor's spectrum.
-    #[arg(long, default_value_t = 1e-10)]
+    #[arg(long, default_value_t = 1e-10, value_parser = super::args::tolerance)]
     tol: f64,
     /// Print one JSON object (the scripting interface).
     #[arg(long)]
@@ -79,8 +79,9 @@ fn known_stderr(stderr: f64, sets: usize) -> Option<f64> {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
+    let members = super::args::family_members(a.members, a.family.as_deref())?;
     let Some(spec) = &a.integrand else {
-        return square(&a);
+        return square(&a, members);
     };
     // A scene pixel has no closed form: only the empirical predictor,
     // which evaluates f, applies (`--method all` runs it alone).
@@ -239,18 +240,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 /// `predict --family`: the unshifted estimator's MSE over a family of
 /// square integrands, by brute force (every member at every point), and
 /// for half-planes by the closed form beside it (two independent ways).
-fn square(a: &Args) -> anyhow::Result<()> {
+fn square(a: &Args, members: usize) -> anyhow::Result<()> {
     use varspec::square::halfplanes::halfplane_mse;
     use varspec::square::{Family, family_mse};
 
     let family = Family::parse(a.family.as_deref().unwrap_or_default())?;
     let source = a.source.resolve_seeded(Some(2))?;
-    varspec::square::mse::check_family_memory(a.members, source.count())?;
+    varspec::square::mse::check_family_memory(members, source.count())?;
     let sets = source.realizations()?;
     let n = source.points_per_set();
     let start = Instant::now();
     let seed = a.source.seed();
-    let brute = family_mse(&sets, &family, a.members, seed);
+    let brute = family_mse(&sets, &family, members, seed);
     let mut out = serde_json::Map::new();
     out.insert("domain".into(), json!("square"));
     out.insert(

@@ -312,6 +312,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             None => String::new(),
         }
     );
+    if let Some(mse) = summary["mse_against_reference"].as_f64() {
+        eprintln!("MSE against the reference {mse:.4e}");
+    }
     let written: Vec<String> = std::iter::once(Some(output.as_path()))
         .chain(a.side_outputs())
         .flatten()

@@ -98,11 +98,8 @@ impl SourceArgs {
                 }
                 let mut sets = read_point_sets(path)?;
                 if let Some(density) = self.density {
-                    sets = sets
-                        .into_iter()
-                        .map(|s| s.with_density(density))
-                        .collect::<Result<_, _>>()
-                        .context("--density")?;
+                    sets =
+                        varspec::PointSet::all_with_density(sets, density).context("--density")?;
                 }
                 Source::File {
                     sets,

@@ -42,7 +42,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
     /// Relative tolerance of the fast method (1e-14 to 0.1; default 1e-9).
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(value_parser = super::args::tolerance, long, allow_hyphen_values = true)]
     tol: Option<f64>,
     /// CSV of the spectrum: kx,ky,power.
     #[arg(long)]
@@ -140,6 +140,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 MethodArg::Fast => Method::Fast {
                     tolerance: a.tol.unwrap_or(1e-9),
                 },
+                MethodArg::Direct if a.tol.is_some() => {
+                    bail!("--tol applies to --method fast; the direct sums are exact")
+                }
                 MethodArg::Direct => Method::Direct,
             };
             check_memory(&freqs, method, a.res)?;

@@ -142,7 +142,7 @@ pub enum SamplerError {
         key: String,
     },
     /// A parameter the sampler does not have.
-    #[error("{sampler}: unknown parameter `{key}`; its parameters: {known}")]
+    #[error("{sampler}: unknown parameter `{key}`; its parameters: {known}{hint}")]
     UnknownParam {
         /// Sampler name.
         sampler: &'static str,
@@ -150,6 +150,8 @@ pub enum SamplerError {
         key: String,
         /// The sampler's keys.
         known: String,
+        /// Where the key may have come from (empty if nowhere likely).
+        hint: String,
     },
     /// A parameter value out of its domain.
     #[error("{sampler}: parameter {key}={value} is invalid: expected {expected}")]

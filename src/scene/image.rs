@@ -91,7 +91,11 @@ impl GreyImage {
         };
         let scale: f64 = fields[3]
             .parse()
-            .map_err(|_| bad("scale is not a number"))?;
+            .ok()
+            .filter(|s: &f64| s.is_finite() && *s != 0.0)
+            .ok_or_else(|| {
+                bad("scale is not a nonzero number (its sign is the byte order: < 0 little-endian)")
+            })?;
         let data = bytes.get(i..).unwrap_or_default();
         if data.len() != 4 * width * height {
             return Err(bad(&format!(
@@ -112,6 +116,16 @@ impl GreyImage {
             .chunks_exact(4 * width)
             .map(|row| row.chunks_exact(4).map(value).collect())
             .collect();
+        // PFM rows run bottom to top.
+        for (r, row) in rows.iter().enumerate() {
+            if let Some(x) = row.iter().position(|v| !v.is_finite()) {
+                return Err(bad(&format!(
+                    "pixel ({x}, {}) is {}, not a finite value",
+                    height - 1 - r,
+                    row[x]
+                )));
+            }
+        }
         Ok(GreyImage {
             width,
             height,
@@ -184,5 +198,57 @@ impl GreyImage {
             },
             path,
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(bytes: &[u8]) -> Result<GreyImage, String> {
+        let dir = std::env::temp_dir().join(format!("varspec-pfm-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let file = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let path = dir.join(format!("{file}.pfm"));
+        std::fs::write(&path, bytes).unwrap();
+        let image = GreyImage::read_pfm(&path);
+        std::fs::remove_file(&path).unwrap();
+        image
+    }
+
+    fn pfm(scale: &str, values: [f32; 2]) -> Vec<u8> {
+        let mut bytes = format!("Pf\n2 1\n{scale}\n").into_bytes();
+        for v in values {
+            bytes.extend(v.to_le_bytes());
+        }
+        bytes
+    }
+
+    #[test]
+    fn a_written_image_reads_back() {
+        let image = GreyImage {
+            width: 2,
+            height: 2,
+            pixels: vec![0.25, 1.5, -2.0, 8.0],
+        };
+        let mut bytes = Vec::new();
+        image.pfm(&mut bytes).unwrap();
+        assert_eq!(read(&bytes).unwrap(), image);
+    }
+
+    #[test]
+    fn non_finite_pixels_and_a_zero_scale_are_refused() {
+        let nan = read(&pfm("-1.0", [0.5, f32::NAN])).unwrap_err();
+        assert!(
+            nan.contains("pixel (1, 0) is NaN, not a finite value"),
+            "{nan}"
+        );
+        let inf = read(&pfm("-1.0", [f32::INFINITY, 0.5])).unwrap_err();
+        assert!(inf.contains("pixel (0, 0) is inf"), "{inf}");
+        for scale in ["0", "0.0", "nan", "inf"] {
+            let e = read(&pfm(scale, [0.5, 0.5])).unwrap_err();
+            assert!(e.contains("scale is not a nonzero number"), "{scale}: {e}");
+        }
     }
 }

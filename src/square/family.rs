@@ -86,6 +86,22 @@ impl Family {
         if name == "file" {
             return read_list(rest).map_err(fail);
         }
+        let keys: &[(&str, f64)] = match name {
+            "gaussians" => &[("vmin", 0.01), ("vmax", 1.0)],
+            "halfplanes" => &[],
+            "disks" => &[("rmin", 0.05), ("rmax", 0.45)],
+            "boxes" => &[("smin", 0.05), ("smax", 0.45)],
+            "family" | "power" | "radial" => {
+                return Err(fail(format!(
+                    "`{name}:` is a torus target; on the square a term is a family (gaussians, halfplanes, disks, boxes, file:PATH) or `blue`, e.g. `halfplanes+gaussians+16*blue`"
+                )));
+            }
+            _ => {
+                return Err(fail(format!(
+                    "unknown family `{name}` (known: gaussians, halfplanes, disks, boxes, file:PATH)"
+                )));
+            }
+        };
         let mut pairs: Vec<(String, f64)> = Vec::new();
         for (k, v) in crate::spec_params::key_values(rest).map_err(|e| fail(e.to_string()))? {
             let value: f64 = v
@@ -98,17 +114,6 @@ impl Family {
             }
             pairs.push((k.to_string(), value));
         }
-        let keys: &[(&str, f64)] = match name {
-            "gaussians" => &[("vmin", 0.01), ("vmax", 1.0)],
-            "halfplanes" => &[],
-            "disks" => &[("rmin", 0.05), ("rmax", 0.45)],
-            "boxes" => &[("smin", 0.05), ("smax", 0.45)],
-            _ => {
-                return Err(fail(format!(
-                    "unknown family `{name}` (known: gaussians, halfplanes, disks, boxes, file:PATH)"
-                )));
-            }
-        };
         if let Some((k, _)) = pairs
             .iter()
             .find(|(k, _)| !keys.iter().any(|(n, _)| n == k))
