@@ -267,6 +267,8 @@ pub const SAMPLERS: &[SamplerInfo] = &[
 /// # Errors
 /// [`SamplerError::Unknown`] listing the known names.
 pub fn find(name: &str) -> Result<&'static SamplerInfo, SamplerError> {
+    // Whitespace around names is ignored, as in integrand specs.
+    let name = name.trim();
     SAMPLERS
         .iter()
         .find(|s| s.name == name || s.aliases.contains(&name))
@@ -421,6 +423,15 @@ mod tests {
         all.sort_unstable();
         all.dedup();
         assert_eq!(all.len(), count);
+    }
+
+    #[test]
+    fn names_are_found_whatever_whitespace_surrounds_them() {
+        assert_eq!(find(" cmj ").unwrap().name, "cmj");
+        assert_eq!(
+            build(" cmj:m=4", 16, None, &[]).unwrap().points_per_set(),
+            16
+        );
     }
 
     #[test]

@@ -192,6 +192,18 @@ fn duplicates_after_adjustment_are_refused_naming_the_values() {
             "radial.half = 0 must be at least 1",
         ),
         (
+            SMALL.replace("[\"random\", \"jitter\", \"cmj\"]", "[]"),
+            "`samplers` is empty; give at least one",
+        ),
+        (
+            SMALL.replace("[16, 64, 256]", "[]"),
+            "`n` is empty; give at least one",
+        ),
+        (
+            SMALL.replace("\"sets\": 4", "\"sets\": 0"),
+            "`sets` is 0; give at least 1",
+        ),
+        (
             SMALL.replace("\"half\": 20", "\"half\": 5000"),
             "(10001^2 = 100020001 in 2D)",
         ),

@@ -37,14 +37,14 @@ pub struct Args {
     /// everywhere); warp:K (the footprint warp of slope K everywhere).
     #[arg(long, default_value = "none", allow_hyphen_values = true)]
     shear: String,
-    /// Pilot estimates per candidate shear (--shear pilot).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = DEFAULT_PILOTS)]
+    /// Pilot estimates per candidate shear (--shear pilot; at least 2).
+    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long, default_value_t = DEFAULT_PILOTS)]
     pilots: usize,
     /// Seed: the same seed gives the same image for any thread count.
     #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Independent renders; 2 or more also give the per-pixel variance.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 1)]
+    #[arg(value_parser = super::args::whole_at_least::<1, usize>, allow_negative_numbers = true, long, default_value_t = 1)]
     renders: usize,
     /// Tone-mapped PNG of the (mean) image (default out/render/SCENE.png).
     #[arg(short = 'o', long = "output")]

@@ -138,10 +138,17 @@ impl Experiment {
                  ExperimentFile::parse reads either kind"
             )));
         }
-        if e.samplers.is_empty() || e.integrands.is_empty() || e.n.is_empty() || e.sets == 0 {
-            return Err(invalid(
-                "samplers, integrands and n must be non-empty and sets >= 1".into(),
-            ));
+        for (field, empty) in [
+            ("samplers", e.samplers.is_empty()),
+            ("integrands", e.integrands.is_empty()),
+            ("n", e.n.is_empty()),
+        ] {
+            if empty {
+                return Err(invalid(format!("`{field}` is empty; give at least one")));
+            }
+        }
+        if e.sets == 0 {
+            return Err(invalid("`sets` is 0; give at least 1".into()));
         }
         let mut dims = Vec::new();
         let mut canonical: Vec<String> = Vec::new();

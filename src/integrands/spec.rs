@@ -173,11 +173,25 @@ impl Params {
         }
     }
 
+    /// A centre on the torus: it wraps, so [−1, 2] says every place (far
+    /// out a coordinate loses the fraction that places it).
     fn centre(&self) -> Result<[f64; 2], IntegrandError> {
+        let on_torus = |c: f64| (-1.0..=2.0).contains(&c);
+        let what = "a coordinate in [-1, 2] (it wraps on the torus)";
         Ok([
-            self.number("cx", |_| true, "a number")?,
-            self.number("cy", |_| true, "a number")?,
+            self.number("cx", on_torus, what)?,
+            self.number("cy", on_torus, what)?,
         ])
+    }
+
+    /// An angle in degrees, one turn either way (far out an angle loses the
+    /// fraction of a turn that orients it).
+    fn angle(&self) -> Result<f64, IntegrandError> {
+        self.number(
+            "angle",
+            |a| (-360.0..=360.0).contains(&a),
+            "an angle in degrees in [-360, 360]",
+        )
     }
 }
 
@@ -241,7 +255,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
                 p.number("w", unit, "a side in (0, 1]")?,
                 p.number("h", unit, "a side in (0, 1]")?,
             );
-            let angle = p.number("angle", |_| true, "an angle in degrees")?;
+            let angle = p.angle()?;
             Rect::new(w, h, p.centre()?, angle)
                 .map_err(|e| p.bad("angle", &e))?
                 .boxed()
@@ -261,15 +275,10 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
             } else {
                 sx
             };
-            Box::new(Gaussian::new(
-                sx,
-                sy,
-                p.number("angle", |_| true, "an angle in degrees")?,
-                p.centre()?,
-            )?)
+            Box::new(Gaussian::new(sx, sy, p.angle()?, p.centre()?)?)
         }
         "halfplane" => Box::new(HalfPlane::new(
-            p.number("angle", |_| true, "an angle in degrees")?,
+            p.angle()?,
             p.number("offset", |o| o.abs() <= 1.0, "an offset in [-1, 1]")?,
         )?),
         "defocus" => Box::new(Defocus::new(

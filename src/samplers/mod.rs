@@ -84,7 +84,7 @@ pub enum SamplerError {
         sampler: &'static str,
     },
     /// A dimension the sampler does not support.
-    #[error("{sampler}: dimension {dim} is not supported (supported: {min} to {max})")]
+    #[error("{sampler}: dimension {dim} is not supported ({})", supported(*min, *max))]
     Dimension {
         /// Sampler name.
         sampler: &'static str,
@@ -181,6 +181,14 @@ pub enum SamplerError {
         /// Relative radius ρ.
         rho: f64,
     },
+}
+
+fn supported(min: usize, max: usize) -> String {
+    if min == max {
+        format!("it is {min}D only")
+    } else {
+        format!("supported: {min} to {max}")
+    }
 }
 
 fn nearest(below: Option<usize>, above: Option<usize>) -> String {
