@@ -261,14 +261,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                 let sums = LayerSums::for_light_field(light, &ks, method);
                 let transforms = sums.transforms();
                 let (seconds, totals) = time(3, || {
-                    // A transform runs in parallel itself: sets in turn.
-                    let per_set: Vec<Vec<f64>> = if transforms {
-                        sets.iter().map(|set| sums.pair_sums(set, shear)).collect()
-                    } else {
-                        sets.par_iter()
-                            .map(|set| sums.pair_sums(set, shear))
-                            .collect()
-                    };
+                    let per_set = sums.pair_sums(&sets, shear);
                     (0..ks.len())
                         .map(|i| per_set.iter().map(|p| p[i]).sum::<f64>())
                         .collect::<Vec<f64>>()

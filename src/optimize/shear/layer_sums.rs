@@ -29,6 +29,7 @@
 //! thread against the memory free) refuses the grids: the powers then sum
 //! every term, and the sums differ in their last ~10 digits.
 
+use rayon::prelude::*;
 use rustfft::num_complex::Complex64;
 
 use crate::integrands::LightField;
@@ -112,6 +113,9 @@ pub struct LayerSums {
     /// The terms in a box, when a transform sums them (the runs hold the
     /// rest).
     transform: Option<BoxTransform>,
+    /// The buffers a transform uses (its grids: 250 MB at N = 4096), kept
+    /// from one call to the next rather than allocated for each.
+    kept: std::sync::Mutex<Scratch>,
 }
 
 /// Buffers of one thread.
@@ -218,6 +222,7 @@ impl LayerSums {
             slopes,
             amplitudes,
             transform,
+            kept: std::sync::Mutex::default(),
         }
     }
 
@@ -240,15 +245,41 @@ impl LayerSums {
         self.transform.is_some()
     }
 
-    /// The pair sums Σ_(l≠m) ψ_k(q_l)·conj(ψ_k(q_m)) of every term on the
-    /// (u, v) set `set` at shear `shear`.
-    pub fn pair_sums(&self, set: &PointSet, shear: [f64; 2]) -> Vec<f64> {
-        let mut scratch = Scratch::default();
-        let mut power = vec![0.0; self.terms];
-        self.power_sums(set, shear, &mut scratch, &mut power);
-        let mut diagonal = vec![0.0; self.terms];
-        self.diagonals(set, &mut scratch, &mut diagonal);
-        power.iter().zip(&diagonal).map(|(p, d)| p - d).collect()
+    /// `each` of every one of `items` with buffers, in the items' order:
+    /// one at a time on the buffers kept between calls when a transform
+    /// sums terms (it runs in parallel itself, on grids too large to hold
+    /// one per task), else in parallel with buffers per task. The same
+    /// results for any number of threads.
+    pub(super) fn map_items<I: Sync, T: Send>(
+        &self,
+        items: &[I],
+        each: impl Fn(&I, &mut Scratch) -> T + Sync,
+    ) -> Vec<T> {
+        if self.transforms() {
+            // A poisoned lock only means a panic elsewhere mid-call; the
+            // buffers are overwritten before use.
+            let mut kept = self
+                .kept
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            return items.iter().map(|item| each(item, &mut kept)).collect();
+        }
+        items
+            .par_iter()
+            .map_init(Scratch::default, |scratch, item| each(item, scratch))
+            .collect()
+    }
+
+    /// The pair sums Σ_(l≠m) ψ_k(q_l)·conj(ψ_k(q_m)) of every term on each
+    /// (u, v) set of `sets` at shear `shear`.
+    pub fn pair_sums(&self, sets: &[PointSet], shear: [f64; 2]) -> Vec<Vec<f64>> {
+        self.map_items(sets, |set, scratch| {
+            let mut power = vec![0.0; self.terms];
+            self.power_sums(set, shear, scratch, &mut power);
+            let mut diagonal = vec![0.0; self.terms];
+            self.diagonals(set, scratch, &mut diagonal);
+            power.iter().zip(&diagonal).map(|(p, d)| p - d).collect()
+        })
     }
 
     /// Writes |Σ_l ψ_k(q_l)|² on the (u, v) set `set` at shear (a, b) to
@@ -695,10 +726,10 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            pool.install(|| sums.pair_sums(&set, [0.2, -0.7]))
+            pool.install(|| sums.pair_sums(std::slice::from_ref(&set), [0.2, -0.7]))
         };
-        let one = on(1);
-        let three = on(3);
+        let one = on(1).remove(0);
+        let three = on(3).remove(0);
         assert!(
             one.iter()
                 .zip(&three)

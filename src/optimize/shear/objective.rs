@@ -32,7 +32,6 @@
 //! the 2D shape g alone, which is why the light field's own shear is the
 //! optimum wherever p_k < 1.
 
-use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rayon::prelude::*;
@@ -133,9 +132,6 @@ struct TermSet {
     weighted_diagonal: Vec<f64>,
     /// The mean diagonal over the (u, v) realizations, per term.
     mean_diagonal: Vec<f64>,
-    /// The buffers of a transform (its grids: 250 MB at N = 4096), kept
-    /// from one evaluation to the next rather than allocated for each.
-    transform_scratch: Mutex<Scratch>,
 }
 
 /// The objective J(a, b): the expected variance of the (x, y)-shifted
@@ -456,13 +452,12 @@ impl<'a> ShearObjective<'a> {
             ),
             weighted_diagonal: Vec::new(),
             mean_diagonal: Vec::new(),
-            transform_scratch: Mutex::default(),
         };
         if let UvPairs::Empirical(uv) = &self.uv {
             let (weighted, total) = sum_over_sets(
                 set.terms.len(),
                 &uv.sets,
-                set.layer_sums.transforms(),
+                &set.layer_sums,
                 |q, scratch, d| set.layer_sums.diagonals(q, scratch, d),
                 |d| crate::sum::sum(set.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)),
             );
@@ -521,43 +516,24 @@ impl<'a> ShearObjective<'a> {
     /// J − Var f/N on each realization of the (u, v) half (the (x, y) half
     /// at its mean), computed per realization so the result is the same
     /// for any number of threads.
-    /// (The sets one at a time when a transform sums the terms: it runs in
-    /// parallel itself, on grids too large to hold one per task.)
     fn per_realization(&self, terms: &TermSet, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
-        let one =
-            |scratch: &mut Scratch, sums: &mut Vec<f64>, (set, diagonal): (&PointSet, &f64)| {
-                terms.layer_sums.power_sums(set, shear, scratch, sums);
+        let items: Vec<(&PointSet, f64)> = uv
+            .sets
+            .iter()
+            .zip(terms.weighted_diagonal.iter().copied())
+            .collect();
+        terms
+            .layer_sums
+            .map_items(&items, |&(set, diagonal), scratch| {
+                let mut sums = vec![0.0; terms.terms.len()];
+                terms.layer_sums.power_sums(set, shear, scratch, &mut sums);
                 let power = terms
                     .terms
                     .iter()
-                    .zip(sums.iter())
+                    .zip(&sums)
                     .map(|(t, p)| t.coefficient * p);
                 crate::sum::sum(power.chain([-diagonal]))
-            };
-        let sums = || vec![0.0; terms.terms.len()];
-        if terms.layer_sums.transforms() {
-            // A poisoned lock only means a panic elsewhere mid-evaluation;
-            // the buffers are overwritten before use.
-            let mut scratch = terms
-                .transform_scratch
-                .lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner);
-            let mut sums = sums();
-            return uv
-                .sets
-                .iter()
-                .zip(&terms.weighted_diagonal)
-                .map(|s| one(&mut scratch, &mut sums, s))
-                .collect();
-        }
-        uv.sets
-            .par_iter()
-            .zip(&terms.weighted_diagonal)
-            .map_init(
-                || (Scratch::default(), sums()),
-                |(scratch, sums), s| one(scratch, sums, s),
-            )
-            .collect()
+            })
     }
 
     /// The mean over the (u, v) realizations of each term's pair sum.
@@ -566,7 +542,7 @@ impl<'a> ShearObjective<'a> {
         let (_, total) = sum_over_sets(
             full.terms.len(),
             &uv.sets,
-            full.layer_sums.transforms(),
+            &full.layer_sums,
             |set, scratch, sums| full.layer_sums.power_sums(set, shear, scratch, sums),
             |_| 0.0,
         );
@@ -731,34 +707,29 @@ fn box_index(freqs: &FrequencyBox, k: [i64; 2]) -> usize {
 /// The per-term vectors `fill` writes for each of `sets`, summed over
 /// the sets, and `scalar` of each set's vector, in fixed chunks of
 /// [`CHUNK`] sets (memory: chunks × terms, not sets × terms; the same
-/// sums for any number of threads); the chunks one at a time when
-/// `sequential` (for sums a transform takes: see `per_realization`).
+/// sums for any number of threads), the chunks run as `sums` runs its
+/// items ([`LayerSums::map_items`]).
 fn sum_over_sets(
     terms: usize,
     sets: &[PointSet],
-    sequential: bool,
+    sums: &LayerSums,
     fill: impl Fn(&PointSet, &mut Scratch, &mut [f64]) + Sync,
     scalar: impl Fn(&[f64]) -> f64 + Sync,
 ) -> (Vec<f64>, Vec<f64>) {
-    let chunk_sums = |chunk: &[PointSet]| {
-        let mut scratch = Scratch::default();
+    let chunks: Vec<&[PointSet]> = sets.chunks(CHUNK).collect();
+    let partial = sums.map_items(&chunks, |chunk, scratch| {
         let mut v = vec![0.0; terms];
         let mut total = vec![0.0; terms];
         let mut scalars = Vec::with_capacity(chunk.len());
-        for set in chunk {
-            fill(set, &mut scratch, &mut v);
+        for set in chunk.iter() {
+            fill(set, scratch, &mut v);
             scalars.push(scalar(&v));
             for (t, x) in total.iter_mut().zip(&v) {
                 *t += x;
             }
         }
         (scalars, total)
-    };
-    let partial: Vec<(Vec<f64>, Vec<f64>)> = if sequential {
-        sets.chunks(CHUNK).map(chunk_sums).collect()
-    } else {
-        sets.par_chunks(CHUNK).map(chunk_sums).collect()
-    };
+    });
     let scalars = partial
         .iter()
         .flat_map(|(s, _)| s.iter().copied())
