@@ -245,7 +245,7 @@ pub const SAMPLERS: &[SamplerInfo] = &[
             ParamInfo {
                 key: "domain",
                 default: "torus",
-                help: "torus (shift-randomized estimator) or square (unshifted, d = 2; N must be m^2, the jitter start)",
+                help: "torus (shift-randomized estimator) or square (unshifted, d = 2; starts from jitter, or CMJ where N is not m^2)",
             },
             ParamInfo {
                 key: "target",

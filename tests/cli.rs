@@ -950,6 +950,44 @@ fn a_closed_standard_output_is_not_an_error() {
         assert!(out.status.success(), "{args:?}: {:?}: {err}", out.status);
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
+    // The files a command was asked for are written all the same (the
+    // report and the curve were lost when the first print stopped it).
+    let dir = temp_dir("closed-stdout");
+    let p = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args([
+            "optimize",
+            "points",
+            "-n",
+            "64",
+            "--target",
+            "disk",
+            "--sets",
+            "1",
+            "--iters",
+            "20",
+            "-o",
+            &p("k.csv"),
+            "--report",
+            &p("k.json"),
+            "--curve",
+            &p("kc.csv"),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for name in ["k.csv", "k.json", "kc.csv"] {
+        assert!(dir.join(name).is_file(), "{name} not written");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[cfg(target_os = "linux")]

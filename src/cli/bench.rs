@@ -39,7 +39,7 @@ pub struct ShearArgs {
     /// CSV of the table.
     #[arg(long, default_value = "out/bench/bench-shear.csv")]
     csv: PathBuf,
-    /// Skip N = 1024.
+    /// Skip N = 1024 and 4096.
     #[arg(long)]
     quick: bool,
 }
@@ -141,10 +141,10 @@ fn samplers(a: SamplersArgs) -> anyhow::Result<()> {
     // One thread: the cost of a coordinate, not of the machine.
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let (repeats, log2) = if a.quick { (1, 16) } else { (3, 20) };
-    println!(
+    outln!(
         "nanoseconds per coordinate drawn (one thread, best of {repeats} run(s) of 2^{log2} coordinates)"
     );
-    println!("{:<22} {:>6} {:>4} {:>12}", "sampler", "N", "d", "ns/coord");
+    outln!("{:<22} {:>6} {:>4} {:>12}", "sampler", "N", "d", "ns/coord");
     let mut rows = Vec::new();
     for name in TIMED_SAMPLERS {
         for n in [16usize, 256, 4096] {
@@ -164,7 +164,7 @@ fn samplers(a: SamplersArgs) -> anyhow::Result<()> {
                 });
                 drawn?;
                 let ns = seconds * 1e9 / (sets * n * dim) as f64;
-                println!("{name:<22} {n:>6} {dim:>4} {ns:>12.1}");
+                outln!("{name:<22} {n:>6} {dim:>4} {ns:>12.1}");
                 rows.push(Row {
                     sampler: name.to_string(),
                     n,
@@ -177,7 +177,7 @@ fn samplers(a: SamplersArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, rows.iter()))?;
-    println!("wrote {}", a.csv.display());
+    outln!("wrote {}", a.csv.display());
     Ok(())
 }
 
@@ -207,12 +207,16 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     const SETS: u64 = 16;
     let shear = [-0.3, 0.2];
     let threads = rayon::current_num_threads();
-    println!(
+    outln!(
         "shear objective, (u, v) pair sums of one evaluation: {SETS} Poisson-disk sets, |k| <= {HALF}, shear {shear:?}, {threads} threads"
     );
-    println!(
+    outln!(
         "{:<52} {:<12} {:>7} {:>10} {:>12}",
-        "case", "method", "terms", "seconds", "max error"
+        "case",
+        "method",
+        "terms",
+        "seconds",
+        "max error"
     );
     let ks: Vec<[i64; 2]> = (0..=HALF)
         .flat_map(|kx| (-HALF..=HALF).map(move |ky| [kx, ky]))
@@ -297,7 +301,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                 methods.push((format!("{name} {tolerance:.0e}"), seconds, error(&sums)));
             }
             for (method, seconds, err) in methods {
-                println!(
+                outln!(
                     "{case:<52} {method:<12} {:>7} {seconds:>10.4} {err:>12.2e}",
                     ks.len()
                 );
@@ -313,7 +317,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
-    println!("wrote {}", a.csv.display());
+    outln!("wrote {}", a.csv.display());
     Ok(())
 }
 
@@ -349,9 +353,14 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     let text = bench_scene(a.subdivisions);
     let threads = rayon::current_num_threads();
     let mut out: Vec<RenderRow> = Vec::new();
-    println!(
+    outln!(
         "{:<6} {:>10} {:>8} {:>12} {:>18} {:>18}",
-        "bvh", "triangles", "threads", "build (s)", "camera rays/s", "shadow rays/s"
+        "bvh",
+        "triangles",
+        "threads",
+        "build (s)",
+        "camera rays/s",
+        "shadow rays/s"
     );
     for (label, kind) in [("cwbvh", BvhKind::Cwbvh), ("bvh2", BvhKind::Bvh2)] {
         let start = Instant::now();
@@ -407,7 +416,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
             rays as f64 / camera_seconds,
             points.len() as f64 / shadow_seconds,
         );
-        println!(
+        outln!(
             "{label:<6} {:>10} {threads:>8} {build:>12.3} {camera_rate:>18.3e} {shadow_rate:>18.3e}",
             scene.geometry().triangle_count()
         );
@@ -422,7 +431,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         });
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, &out))?;
-    println!("wrote {}", a.csv.display());
+    outln!("wrote {}", a.csv.display());
     Ok(())
 }
 
@@ -476,12 +485,14 @@ fn time<T>(repeats: usize, mut f: impl FnMut() -> T) -> (f64, T) {
 fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
     let mut rows = Vec::new();
     let threads = rayon::current_num_threads();
-    println!(
-        "speed against error, {threads} threads; errors are max over k against the direct sums"
-    );
-    println!(
+    outln!("speed against error, {threads} threads; errors are max over k against the direct sums");
+    outln!(
         "{:<44} {:<16} {:>11} {:>14} {:>14}",
-        "case", "method", "seconds", "max |dP|", "max |dS|/N"
+        "case",
+        "method",
+        "seconds",
+        "max |dP|",
+        "max |dS|/N"
     );
 
     // N = 4096 random points on the 256² box (|k| < 128).
@@ -491,7 +502,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
     let case = format!("random N={n}, 256^2 box");
     let (direct_s, exact) = time(2, || sample_spectrum(&points, &freqs));
     let push = |rows: &mut Vec<Row>, r: Row| {
-        println!(
+        outln!(
             "{:<44} {:<16} {:>11.5} {:>14} {:>14}",
             r.case,
             r.method,
@@ -639,19 +650,23 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
-    println!("wrote {}", a.csv.display());
+    outln!("wrote {}", a.csv.display());
     Ok(())
 }
 
 fn predict(a: PredictArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
-    println!(
+    outln!(
         "variance predictors: time and relative error against the exact spatial form, {threads} threads"
     );
-    println!("one jittered set per row group, shift-randomized estimator");
-    println!(
+    outln!("one jittered set per row group, shift-randomized estimator");
+    outln!(
         "{:<40} {:<26} {:>10} {:>12} {:>11}",
-        "case", "method", "seconds", "variance", "rel. error"
+        "case",
+        "method",
+        "seconds",
+        "variance",
+        "rel. error"
     );
     let mut rows: Vec<PredictRow> = Vec::new();
     let ns: &[usize] = if a.quick { &[1024] } else { &[1024, 4096] };
@@ -664,7 +679,7 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
             let (exact, rounding) = exact?;
             let mut row = |method: String, seconds: f64, variance: f64| {
                 let rel = (variance - exact) / exact;
-                println!("{case:<40} {method:<26} {seconds:>10.4} {variance:>12.5e} {rel:>11.2e}");
+                outln!("{case:<40} {method:<26} {seconds:>10.4} {variance:>12.5e} {rel:>11.2e}");
                 rows.push(PredictRow {
                     case: case.clone(),
                     method,
@@ -703,7 +718,7 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
-    println!("wrote {}", a.csv.display());
+    outln!("wrote {}", a.csv.display());
     Ok(())
 }
 

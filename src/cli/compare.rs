@@ -90,15 +90,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
 
-    println!("2D samplers, {} sets each, seed {}:", a.sets, a.seed);
-    println!(
+    outln!("2D samplers, {} sets each, seed {}:", a.sets, a.seed);
+    outln!(
         "{:<16} {:>6} {:>10} {:>8} {:>8}",
-        "sampler", "N", "Mpoints/s", "nn_min", "nn_mean"
+        "sampler",
+        "N",
+        "Mpoints/s",
+        "nn_min",
+        "nn_mean"
     );
     for r in &rows {
-        println!(
+        outln!(
             "{:<16} {:>6} {:>10.2} {:>8.3} {:>8.3}",
-            r.name, r.n, r.mpts_per_s, r.min_rel, r.mean_rel
+            r.name,
+            r.n,
+            r.mpts_per_s,
+            r.min_rel,
+            r.mean_rel
         );
     }
     let moved: Vec<String> = rows
@@ -107,13 +115,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map(|r| format!("{} N = {}", r.name, r.n))
         .collect();
     if !moved.is_empty() {
-        println!(
+        outln!(
             "N: {} (the nearest N their structure allows to -n {})",
             moved.join(", "),
             a.n
         );
     }
-    println!(
+    outln!(
         "nn_min / nn_mean: minimum and mean nearest-neighbour distance over the hexagonal packing distance \
          sqrt(2/(sqrt(3) N)) (Lagae & Dutre 2008; 1 = densest packing, random ~ 0.01 / 0.5)."
     );
@@ -140,7 +148,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }),
         )
     })?;
-    println!(
+    outln!(
         "wrote {} and one PNG per sampler in {}",
         csv.display(),
         a.output.display()

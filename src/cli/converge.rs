@@ -255,16 +255,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "slope": fit.slope, "slope_ci": fit.slope_ci.map(|(l, h)| vec![l, h]),
             "theory": theory, "adjusted_n": adjusted,
         });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        outln!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
     if !adjusted.is_empty() {
-        println!("N adjusted to fit {}: {}", a.sampler, adjusted.join(", "));
+        outln!("N adjusted to fit {}: {}", a.sampler, adjusted.join(", "));
     }
-    println!("{:>8} {:>14} {:>12}", "N", "variance", "stderr");
+    outln!("{:>8} {:>14} {:>12}", "N", "variance", "stderr");
     for p in &points {
         let stderr = p.stderr.map_or("unknown".into(), |s| format!("{s:.2e}"));
-        println!("{:>8} {:>14.6e} {stderr:>12}", p.n, p.variance);
+        outln!("{:>8} {:>14.6e} {stderr:>12}", p.n, p.variance);
     }
     let ci = fit
         .slope_ci
@@ -272,6 +272,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             format!("[{l:.3}, {h:.3}]")
         });
     let theory = theory.map_or("none in the table".into(), |t| format!("{t}"));
-    println!("slope {:.3}, 95% CI {ci}; theory {theory}", fit.slope);
+    outln!("slope {:.3}, 95% CI {ci}; theory {theory}", fit.slope);
     Ok(())
 }

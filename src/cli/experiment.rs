@@ -81,8 +81,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 bar.suspend(|| eprintln!("figures[{i}]: {seconds:.1} s"));
             })?;
             bar.finish_and_clear();
-            print!("{md}");
-            println!("wrote {}", out.display());
+            super::stdout::bytes(md.as_bytes());
+            outln!("wrote {}", out.display());
             return Ok(());
         }
     };
@@ -105,12 +105,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         let json = serde_json::to_string_pretty(&shard_file)?;
         write_atomic(&out.join(&name), |w| w.write_all(json.as_bytes()))?;
-        println!("wrote {}", out.join(name).display());
+        outln!("wrote {}", out.join(name).display());
         return Ok(());
     }
     let md = write_results(&e, &file, &cells, &out)?;
-    print!("{md}");
-    println!("wrote {}", out.display());
+    super::stdout::bytes(md.as_bytes());
+    outln!("wrote {}", out.display());
     Ok(())
 }
 
@@ -144,7 +144,7 @@ pub fn merge(a: MergeArgs) -> anyhow::Result<()> {
     let out = a.output.unwrap_or(a.folder);
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
     write_results(&e, &file, &cells, &out)?;
-    println!(
+    outln!(
         "merged {} shards of {} into {}",
         shards.len(),
         e.name,

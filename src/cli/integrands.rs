@@ -27,6 +27,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         out += "; parameters: varspec integrands --list";
     }
     out += "\n";
-    print!("{out}");
+    super::stdout::bytes(out.as_bytes());
     Ok(())
 }

@@ -1,6 +1,8 @@
 //! Command-line parsing and dispatch. Each subcommand lives in its own file;
 //! errors are printed once, here, and turn into a non-zero exit.
 
+#[macro_use]
+mod stdout;
 mod args;
 mod bench;
 mod compare;
@@ -101,25 +103,14 @@ enum Command {
 /// Parses the arguments, runs the subcommand, reports any error on stderr.
 pub fn main() -> ExitCode {
     let cli = Cli::from_arg_matches(&grammar().get_matches()).unwrap_or_else(|e| e.exit());
-    // `println!` panics when standard output cannot be written. Closed
-    // early (`varspec … | head`) is not an error: say nothing and stop the
-    // command there, keeping what it wrote. Any other failure (a full
-    // disk) is one: an error line, and no file output appears.
-    let default_hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        if stdout_failure(info.payload()).is_none() {
-            default_hook(info);
-        }
-    }));
-    // A command's outputs appear together or not at all.
+    // A command's outputs appear together or not at all; a standard
+    // output that failed (not merely closed: see `stdout`) fails it.
     let result = varspec::io::all_or_nothing(|| {
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run(cli.command))).unwrap_or_else(
-            |payload| match stdout_failure(payload.as_ref()) {
-                Some(reason) if reason.contains("Broken pipe") => Ok(()),
-                Some(reason) => Err(anyhow::anyhow!("cannot write to standard output: {reason}")),
-                None => std::panic::resume_unwind(payload),
-            },
-        )
+        run(cli.command)?;
+        match stdout::finish() {
+            Some(e) => Err(anyhow::anyhow!("cannot write to standard output: {e}")),
+            None => Ok(()),
+        }
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -129,16 +120,6 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-/// The reason in the panic of `print!` when standard output cannot be
-/// written (`None` for any other panic).
-fn stdout_failure(payload: &(dyn std::any::Any + Send)) -> Option<&str> {
-    let text = payload
-        .downcast_ref::<String>()
-        .map(String::as_str)
-        .or_else(|| payload.downcast_ref::<&str>().copied())?;
-    text.strip_prefix("failed printing to stdout: ")
 }
 
 /// Runs one subcommand.
@@ -156,7 +137,9 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Experiment(a) => experiment::run(a),
         Command::Merge(a) => experiment::merge(a),
         Command::Completions { shell } => {
-            clap_complete::generate(shell, &mut grammar(), "varspec", &mut std::io::stdout());
+            let mut script = Vec::new();
+            clap_complete::generate(shell, &mut grammar(), "varspec", &mut script);
+            stdout::bytes(&script);
             Ok(())
         }
         Command::Optimize(c) => optimize::run(c),

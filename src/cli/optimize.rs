@@ -282,7 +282,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     })?;
     if let Some(found) = plan.lattice() {
         let h = found.lattice.shortest_dual();
-        println!(
+        outln!(
             "start: the best of {} integration lattices of {} points (dual basis ({}, 0), ({}, {}); shortest dual vector ({}, {}): on lines {:.3} apart), exact variance {:.4e}",
             found.candidates,
             a.n,
@@ -295,14 +295,14 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
             found.variance
         );
         if let Some((sum, half)) = found.dual_sum {
-            println!(
+            outln!(
                 "  (at the spatial form's rounding floor {:.1e}; ranked by the dual sum over |k|inf <= {half}: {sum:.4e})",
                 found.rounding_bound
             );
         }
     }
     let frequencies = plan.optimizer().frequencies();
-    println!(
+    outln!(
         "memory: about {:.0} MiB (box |k| <= {}: {} frequencies; {} set(s) at a time)",
         plan.memory_bytes() / (1024.0 * 1024.0),
         frequencies.half,
@@ -350,7 +350,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         (c, Some(h)) if c > 0 => format!("{c} on the box |k| <= {h} then "),
         _ => String::new(),
     };
-    println!(
+    outln!(
         "{} set(s) of {} points for {} in {:.2} s ({coarse}{} iterations for set 0, {}); loss {:.4e}",
         a.sets,
         a.n,
@@ -362,19 +362,19 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     );
     if let Some(v) = design.exact_variance {
         if v <= design.rounding {
-            println!(
+            outln!(
                 "  exact variance (spatial form, no box) {v:.4e}: at the form's rounding floor ({:.1e}); the in-box loss resolves it",
                 design.rounding
             );
         } else {
-            println!(
+            outln!(
                 "  exact variance (spatial form, no box) {v:.4e}: {:.0}% of it lies beyond the box",
                 100.0 * (1.0 - design.mean_loss / v).max(0.0)
             );
         }
     }
     if design.kept_start > 0 {
-        println!(
+        outln!(
             "  {} of {} set(s): the descent did not lower the {}, so the start ({}) is returned unchanged",
             design.kept_start,
             a.sets,
@@ -387,7 +387,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         );
     }
     for (name, v) in &design.comparison {
-        println!(
+        outln!(
             "  {name:<14} loss {:.4e}",
             v["loss"].as_f64().unwrap_or(f64::NAN)
         );
@@ -457,7 +457,7 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     let design = design_projections(&request, &|_, _| bar.inc(1))?;
     bar.finish_and_clear();
     varspec::io::write_point_file(&a.output, &design.points)?;
-    println!(
+    outln!(
         "{} set(s) of {} 4D points optimized for {} projection term(s) in {:.2} s (from {}; set 0: {})",
         a.sets,
         a.n,
@@ -467,15 +467,18 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
         design.stopped[0].describe()
     );
     for t in &design.terms {
-        println!(
+        outln!(
             "  {:<40} loss {:.4e} -> {:.4e}",
-            t.term, t.loss_before, t.loss_after
+            t.term,
+            t.loss_before,
+            t.loss_after
         );
     }
     let closest = design.closest_pair_over_hexagonal;
-    println!(
+    outln!(
         "  closest pair / hexagonal spacing: XY {:.3}, UV {:.3}",
-        closest.xy, closest.uv
+        closest.xy,
+        closest.uv
     );
     if let Some(path) = &a.report {
         write_atomic(path, |w| {
@@ -510,7 +513,7 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     let design = design_on_square(&request, &|_, _| bar.inc(1))?;
     bar.finish_and_clear();
     varspec::io::write_point_file(&a.output, &design.points)?;
-    println!(
+    outln!(
         "{} set(s) of {} points designed on the square for {} in {:.2} s (from {}; set 0: {}); \
          unshifted estimator, scored on {} members per family (seed {})",
         a.sets,
@@ -523,15 +526,18 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
         a.score_seed
     );
     for (name, v) in &design.comparison {
-        print!("  {name:<14}");
-        for f in &design.families {
-            print!(
-                "  {f} {:.3e}",
-                v[f.as_str()]["mse"].as_f64().unwrap_or(f64::NAN)
-            );
-        }
-        println!(
-            "  closest pair {:.3}",
+        let mses: String = design
+            .families
+            .iter()
+            .map(|f| {
+                format!(
+                    "  {f} {:.3e}",
+                    v[f.as_str()]["mse"].as_f64().unwrap_or(f64::NAN)
+                )
+            })
+            .collect();
+        outln!(
+            "  {name:<14}{mses}  closest pair {:.3}",
             v["closest_pair_over_hexagonal"]
                 .as_f64()
                 .unwrap_or(f64::NAN)
@@ -676,10 +682,10 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
         "reduction": reduction, "seconds": seconds,
     });
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        outln!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{} ({} pixel, depth {:.4}, κ {:.4} ({:.4} to {:.4} over the footprint){}{}) with {} N={}, {} realizations per candidate:",
         f.spec(),
         analysis.kind.name(),
@@ -699,7 +705,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
     );
     for (i, m) in found.candidates.iter().enumerate() {
         let e = &m.estimate;
-        println!(
+        outln!(
             "  {} {:<8} ({:>8.4}, {:>8.4})  variance {:.4e} ± {:.1e}",
             if i == found.chosen { "*" } else { " " },
             m.shear.form(),
@@ -709,7 +715,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
             e.stderr
         );
     }
-    println!(
+    outln!(
         "chosen: {} ({:.4}, {:.4}), {} than no shear, search {seconds:.2} s",
         best.shear.form(),
         best.shear.amounts()[0],
@@ -783,10 +789,10 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     let mut out = run.report.clone();
     out["sets"] = json!(a.sets);
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        outln!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         let ratio = found.optimum.value / found.unsheared.value;
-        println!(
+        outln!(
             "shear a = {:.4}, b = {:.4} (spectral start {:.4}, {:.4}{}); expected variance {:.4e} -> {:.4e} ({}), search {search_seconds:.2} s",
             found.shear[0],
             found.shear[1],
@@ -808,7 +814,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             }
         );
         if let Some((before, after)) = check {
-            println!(
+            outln!(
                 "check on {} fresh sets: {:.4e} [{:.4e}, {:.4e}] -> {:.4e} [{:.4e}, {:.4e}]",
                 after.realizations,
                 before.variance,
@@ -824,7 +830,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         Some(CheckVerdict::Contradicts) => eprintln!(
             "warning: the fresh-set check finds the shear worse than none (95% intervals apart), against the search's objective: do not use it; try another --seed, or keep the sets unsheared"
         ),
-        Some(CheckVerdict::Inconclusive) if !a.json => println!(
+        Some(CheckVerdict::Inconclusive) if !a.json => outln!(
             "the check cannot tell the shear from none (95% intervals overlap): raise --realizations to separate them"
         ),
         _ => {}

@@ -194,10 +194,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&Value::Object(out))?);
+        outln!("{}", serde_json::to_string_pretty(&Value::Object(out))?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{} on {} ({}, {sets} sets), I {} {}",
         f.spec(),
         source.name(),
@@ -231,7 +231,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     ),
                 },
             };
-            println!("  {key:<10} {variance:>14}  {note}");
+            outln!("  {key:<10} {variance:>14}  {note}");
         }
     }
     Ok(())
@@ -279,17 +279,17 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
         );
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&Value::Object(out))?);
+        outln!("{}", serde_json::to_string_pretty(&Value::Object(out))?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{} on {} ({}, {} sets), unshifted estimator on the square",
         family.spec(),
         source.name(),
         source.count_label(),
         sets.len()
     );
-    println!(
+    outln!(
         "  brute force  {:.6e}  95% CI [{:.4e}, {:.4e}] over {} members",
         brute.mse,
         (brute.mse - 1.96 * brute.stderr).max(0.0),
@@ -297,7 +297,7 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
         brute.members
     );
     if let Some(v) = out.get("closed_form") {
-        println!(
+        outln!(
             "  closed form  {:.6e}  (Cramér–von Mises over {} directions)",
             v["mse"].as_f64().unwrap_or(f64::NAN),
             v["directions"]

@@ -74,7 +74,7 @@ pub struct Args {
     /// Summary JSON: variance statistics, MSE, time.
     #[arg(long)]
     summary: Option<PathBuf>,
-    /// Per-pixel analysis CSV: px,py,kind,depth,kappa,a,b.
+    /// Per-pixel analysis CSV: px,py,kind,depth,kappa,shear_form,a,b.
     #[arg(long)]
     analysis: Option<PathBuf>,
     /// Heat map PNG of the light-field slope κ each pixel's shear follows.
@@ -108,7 +108,7 @@ impl Args {
 pub fn run(a: Args) -> anyhow::Result<()> {
     if a.list {
         for (name, about, _) in BUILTIN_SCENES {
-            println!("{name}\n    {about}");
+            outln!("{name}\n    {about}");
         }
         return Ok(());
     }

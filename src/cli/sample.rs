@@ -142,6 +142,6 @@ fn list() -> anyhow::Result<()> {
             );
         }
     }
-    print!("{out}");
+    super::stdout::bytes(out.as_bytes());
     Ok(())
 }

@@ -31,8 +31,9 @@ pub struct Args {
     /// Instead of points: the power spectrum P_f = |F_f(k)|² of this
     /// integrand (e.g. disk:r=0.3), a 4D one on the plane --dims (0,2 is
     /// XU, 1,3 is YV). A scene pixel (scene:NAME,px=X,py=Y) has no closed
-    /// form: its marginal on the plane is averaged over a 4K × 4K grid of
-    /// cells, 16 random rays each (seeded by --seed), then transformed.
+    /// form: its marginal on the plane is averaged over a 4h × 4h grid of
+    /// cells (h = (K − 1)/2, the box's largest |k|), 16 random rays each
+    /// (seeded by --seed), then transformed.
     #[arg(long, conflicts_with_all = ["points", "points_flag", "sampler", "n", "sets_given", "params", "density", "method", "tol"])]
     integrand: Option<String>,
     /// Resolution K: the frequency box |k| < K/2 in each axis.

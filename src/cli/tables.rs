@@ -146,7 +146,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             )
         })?;
     }
-    println!(
+    outln!(
         "wrote {} ({} sets of {} points in {}D)",
         a.output.display(),
         sets.len(),
@@ -186,7 +186,7 @@ fn draw_table_shard(a: &Args, shard: Shard) -> anyhow::Result<()> {
     let path = shard_path(&a.output, shard);
     let json = serde_json::to_string(&part)?;
     write_atomic(&path, |w| w.write_all(json.as_bytes()))?;
-    println!(
+    outln!(
         "wrote {} ({mine} of {} sets)",
         path.display(),
         part.run.sets

@@ -1,0 +1,86 @@
+//! Standard output for what commands print. A reader that leaves early
+//! (`varspec … | head -1`) is not an error: later lines are dropped and the
+//! command runs on, so the files it was asked for are still written. Any
+//! other failure (a full disk) is kept, later lines are dropped, and the
+//! command fails with it at the end, so its files do not appear
+//! (`std::println!` would panic in both cases, stopping the command midway).
+
+use std::fmt;
+use std::io::{self, Write};
+use std::sync::Mutex;
+
+/// What has happened to standard output so far.
+enum State {
+    Open,
+    /// The reader left: nothing more is written, and that is fine.
+    Closed,
+    /// A write failed otherwise: nothing more is written, and the command
+    /// fails.
+    Failed(io::Error),
+}
+
+static STATE: Mutex<State> = Mutex::new(State::Open);
+
+/// Writes `args` and a newline to standard output (see the module docs).
+pub fn line(args: fmt::Arguments) {
+    let mut state = STATE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if !matches!(*state, State::Open) {
+        return;
+    }
+    let mut out = io::stdout().lock();
+    let written = out.write_fmt(args).and_then(|()| out.write_all(b"\n"));
+    if let Err(e) = written {
+        *state = if e.kind() == io::ErrorKind::BrokenPipe {
+            State::Closed
+        } else {
+            State::Failed(e)
+        };
+    }
+}
+
+/// Writes `bytes` as they are (see [`line`]).
+pub fn bytes(bytes: &[u8]) {
+    let mut state = STATE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if !matches!(*state, State::Open) {
+        return;
+    }
+    if let Err(e) = io::stdout().lock().write_all(bytes) {
+        *state = if e.kind() == io::ErrorKind::BrokenPipe {
+            State::Closed
+        } else {
+            State::Failed(e)
+        };
+    }
+}
+
+/// Flushes standard output and returns the failure a write met, if any
+/// (a closed reader is none).
+pub fn finish() -> Option<io::Error> {
+    let mut state = STATE
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if matches!(*state, State::Open)
+        && let Err(e) = io::stdout().lock().flush()
+        && e.kind() != io::ErrorKind::BrokenPipe
+    {
+        return Some(e);
+    }
+    match std::mem::replace(&mut *state, State::Closed) {
+        State::Failed(e) => Some(e),
+        _ => None,
+    }
+}
+
+/// `println!` through [`line`].
+macro_rules! outln {
+    () => {
+        $crate::cli::stdout::line(format_args!(""))
+    };
+    ($($arg:tt)*) => {
+        $crate::cli::stdout::line(format_args!($($arg)*))
+    };
+}
