@@ -371,6 +371,18 @@ fn npy_point_sets_round_trip_and_read_what_numpy_writes() {
         npy_by_hand("<f8", false, "(0, 2)", &[]),
         "no points",
     );
+    // A header that is no dictionary: one line, not the parser's report.
+    let mut garbage = b"\x93NUMPY\x01\x00\x36\x00garbage".to_vec();
+    garbage.resize(10 + 0x36 - 1, b' ');
+    garbage.push(b'\n');
+    refuse(
+        "garbage.npy",
+        garbage.clone(),
+        "its header is not a NumPy dictionary",
+    );
+    let path = dir.join("garbage.npy");
+    let message = read_point_sets(&path).unwrap_err().to_string();
+    assert!(!message.contains('\n'), "{message}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -62,8 +62,18 @@ pub const MAGIC: &[u8] = b"\x93NUMPY";
 /// index) or a short read.
 pub fn read_point_sets_npy(mut reader: impl Read) -> Result<Vec<PointSet>, String> {
     let header = read_header_checked(&mut reader)?;
-    let file = NpyFile::new(io::Cursor::new(header).chain(reader))
-        .map_err(|e| format!("not a readable .npy array: {e}"))?;
+    let file = NpyFile::new(io::Cursor::new(header).chain(reader)).map_err(|e| {
+        // npyz's header errors quote the parser's multi-line report: its
+        // first line says what is wrong.
+        let text = e.to_string();
+        match text.split_once('\n') {
+            Some((first, _)) => format!(
+                "not a readable .npy array: its header is not a NumPy dictionary {{'descr': ..., 'fortran_order': ..., 'shape': (...)}} ({})",
+                first.trim()
+            ),
+            None => format!("not a readable .npy array: {text}"),
+        }
+    })?;
     let shape = file.shape().to_vec();
     let (sets, n, d) = match shape[..] {
         [n, d] => (1, n, d),
