@@ -123,6 +123,37 @@ fn names_that_leave_the_output_folder_are_refused() {
 }
 
 #[test]
+fn a_rerun_keeps_the_notes_written_by_hand_below_the_marker() {
+    let dir = temp_dir("experiment-notes");
+    let file = dir.join("e.json");
+    let out = dir.join("out");
+    std::fs::write(&file, SMALL).unwrap();
+    let run = || {
+        ok(&[
+            "experiment",
+            file.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    run();
+    let first = std::fs::read_to_string(out.join("README.md")).unwrap();
+    let notes = format!(
+        "{}\n\n## Why\n\nBecause.\n",
+        varspec::experiment::KEPT_NOTES
+    );
+    std::fs::write(
+        out.join("README.md"),
+        format!("{first}\nA stale line above the marker.\n\n{notes}"),
+    )
+    .unwrap();
+    run();
+    let second = std::fs::read_to_string(out.join("README.md")).unwrap();
+    assert_eq!(second, format!("{}\n\n{notes}", first.trim_end()));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_rerun_with_one_n_removes_the_stale_slopes() {
     let dir = temp_dir("experiment-rerun");
     let file = dir.join("e.json");

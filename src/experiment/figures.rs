@@ -629,6 +629,7 @@ impl FigureExperiment {
             md += "\n";
             on_figure(i, clock.elapsed().as_secs_f64());
         }
+        let md = super::report::with_kept_notes(out, md);
         write_atomic(&out.join("README.md"), |w| w.write_all(md.as_bytes())).map_err(|err| {
             ExperimentError::Invalid {
                 file: file.to_string(),

@@ -279,9 +279,25 @@ pub fn write_results(
                 .map_err(|err| fail(&format!("{name} (stale)"), err.to_string()))?;
         }
     }
+    let md = with_kept_notes(out, md);
     write_atomic(&out.join("README.md"), |w| w.write_all(md.as_bytes()))
         .map_err(|err| fail("README.md", err.to_string()))?;
     Ok(md)
+}
+
+/// The line after which an experiment folder's README holds notes written
+/// by hand (analysis, caveats), which a new run keeps below its own text.
+pub const KEPT_NOTES: &str =
+    "<!-- Notes below this line are written by hand; a new run of the experiment keeps them. -->";
+
+/// `md` followed by the hand-written notes of the README now in `out`
+/// (from its [`KEPT_NOTES`] line on), if it has any.
+pub(super) fn with_kept_notes(out: &Path, md: String) -> String {
+    let old = std::fs::read_to_string(out.join("README.md")).unwrap_or_default();
+    match old.find(KEPT_NOTES) {
+        Some(at) => format!("{}\n\n{}", md.trim_end(), &old[at..]),
+        None => md,
+    }
 }
 
 /// Removes what a run of the other kind left in `out`, so a folder never
@@ -323,13 +339,15 @@ pub fn remove_other_runs(out: &Path, shard: Option<Shard>) -> Result<(), Experim
 /// Removes every table and shard a variance run left in `out`, before a
 /// figure experiment writes its own README.md there (a figure run never
 /// leaves a folder mixing the two kinds; its own earlier PNGs are
-/// overwritten or, for a figure since removed from the file, left).
+/// overwritten or, for a figure since removed from the file, left). The
+/// README itself stays until the run replaces it, keeping its notes
+/// ([`KEPT_NOTES`]), so a failed run leaves it whole.
 ///
 /// # Errors
 /// The first file that could not be removed.
 pub fn remove_variance_runs(out: &Path) -> Result<(), ExperimentError> {
     remove_other_runs(out, None)?;
-    for name in TABLES {
+    for name in TABLES.iter().filter(|&&name| name != "README.md") {
         let path = out.join(name);
         if path.exists() {
             std::fs::remove_file(&path).map_err(|err| ExperimentError::Invalid {
