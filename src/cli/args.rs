@@ -60,7 +60,7 @@ pub const DEFAULT_SETS: usize = 16;
 #[derive(clap::Args)]
 pub struct DrawArgs {
     /// Realizations to draw (with a sampler; default 16).
-    #[arg(value_parser = whole::<usize>, allow_negative_numbers = true, long = "sets", value_name = "SETS")]
+    #[arg(value_parser = whole_at_least::<1, usize>, allow_negative_numbers = true, long = "sets", value_name = "SETS")]
     sets_given: Option<usize>,
     /// Seed (default 0): the same seed gives bit-identical realizations
     /// for any thread count.

@@ -40,7 +40,7 @@ pub struct ShearArgs {
     integrand: String,
     /// Sheared sets written with -o (the search itself uses the expected
     /// variance over the sampler's randomness, not these sets).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = super::args::DEFAULT_SETS)]
+    #[arg(value_parser = super::args::whole_at_least::<1, usize>, allow_negative_numbers = true, long, default_value_t = super::args::DEFAULT_SETS)]
     sets: usize,
     /// Seed of the written sets, of the independent check and of any
     /// realizations behind an estimated half.
@@ -81,7 +81,7 @@ pub struct PointsArgs {
     #[arg(long)]
     target: String,
     /// Independent realizations, optimized in parallel.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = super::args::DEFAULT_SETS)]
+    #[arg(value_parser = super::args::whole_at_least::<1, usize>, allow_negative_numbers = true, long, default_value_t = super::args::DEFAULT_SETS)]
     sets: usize,
     /// Maximum iterations per set (default 1000 on the torus, 2000 on the square).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
@@ -192,9 +192,6 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
             .map(std::path::Path::new)
             .filter(|p| p.is_file())],
     )?;
-    if a.sets == 0 {
-        bail!("--sets must be at least 1");
-    }
     varspec::memory::check(
         &format!("the results of {} designed sets of {} points", a.sets, a.n),
         Some(results_bytes(a.sets, a.n, a.dim, a.iters)),

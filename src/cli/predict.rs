@@ -37,8 +37,9 @@ pub struct Args {
     integrand: Option<String>,
     /// Instead: a family of integrands on the unit square (gaussians,
     /// halfplanes, disks, boxes, file:PATH) and the unshifted estimator's
-    /// mean squared error over it.
-    #[arg(long)]
+    /// mean squared error over it (by brute force; the predictors' options
+    /// do not apply).
+    #[arg(long, conflicts_with_all = ["method", "realizations", "res", "tol"])]
     family: Option<String>,
     /// Members of the family sample (with --family; default 1024; at least
     /// 2, for the standard error).

@@ -8,6 +8,7 @@ use anyhow::{Context, bail};
 
 use super::{args, progress};
 use varspec::io::write_atomic;
+use varspec::optimize::shear::MAX_SHEAR_RANGE;
 use varspec::registry;
 use varspec::report::plot::{HeatMap, heatmap_png};
 use varspec::scene::analysis::{PixelKind, SampleShear};
@@ -37,9 +38,10 @@ pub struct Args {
     /// everywhere); warp:K (the footprint warp of slope K everywhere).
     #[arg(long, default_value = "none", allow_hyphen_values = true)]
     shear: String,
-    /// Pilot estimates per candidate shear (--shear pilot; at least 2).
-    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long, default_value_t = DEFAULT_PILOTS)]
-    pilots: usize,
+    /// Pilot estimates per candidate shear (--shear pilot; at least 2;
+    /// default 32).
+    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
+    pilots: Option<usize>,
     /// Seed: the same seed gives the same image for any thread count.
     #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
@@ -123,10 +125,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     {
         bail!("a variance needs --renders 2 or more");
     }
+    if a.pilots.is_some() && a.shear != "pilot" {
+        bail!("--pilots applies to --shear pilot, not --shear {}", a.shear);
+    }
     let policy = match a.shear.as_str() {
         "none" => ShearPolicy::None,
         "analytic" => ShearPolicy::Analytic,
-        "pilot" => ShearPolicy::Pilot { pilots: a.pilots },
+        "pilot" => ShearPolicy::Pilot {
+            pilots: a.pilots.unwrap_or(DEFAULT_PILOTS),
+        },
         text => {
             let (warp, number) = match text.strip_prefix("warp:") {
                 Some(rest) => (true, rest),
@@ -136,9 +143,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 // The warp of slope 0 would exchange position and lens
                 // coordinates; following an unsheared field is no shear.
                 Ok(s) if s.is_finite() && warp => ShearPolicy::Global(SampleShear::following(s)),
-                Ok(s) if s.is_finite() => ShearPolicy::Global(SampleShear::Position([s, s])),
+                Ok(s) if s.abs() <= MAX_SHEAR_RANGE => {
+                    ShearPolicy::Global(SampleShear::Position([s, s]))
+                }
                 _ => bail!(
-                    "--shear {text}: expected none, analytic, pilot, a finite number A or warp:K"
+                    "--shear {text}: expected none, analytic, pilot, a number A in [-{MAX_SHEAR_RANGE}, {MAX_SHEAR_RANGE}] or warp:K (K finite)"
                 ),
             }
         }

@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use clap::ValueEnum;
 
 use super::{args, progress};
@@ -62,7 +62,7 @@ pub struct Args {
     #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
     /// Number of independent realizations.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = args::DEFAULT_SETS)]
+    #[arg(value_parser = args::whole_at_least::<1, usize>, allow_negative_numbers = true, long, default_value_t = args::DEFAULT_SETS)]
     sets: usize,
     /// Sampler parameter key=value (repeatable; see --list).
     #[arg(long = "param", value_parser = args::key_value)]
@@ -87,9 +87,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.n.expect("clap requires it"),
     );
     args::check_outputs([a.output.as_deref()])?;
-    if a.sets == 0 {
-        bail!("--sets must be at least 1");
-    }
     let sampler = registry::build(&name, n, a.dim, &a.params)?;
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
     let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|| bar.inc(1))?;

@@ -113,9 +113,6 @@ impl SourceArgs {
                         "--density applies to a point-set file; a sampler's sets carry their own density"
                     );
                 }
-                if self.draw.sets() == 0 {
-                    bail!("--sets must be at least 1");
-                }
                 self.draw.check_results_memory()?;
                 let n = self.n.context("--sampler needs -n")?;
                 let sampler = registry::build(name, n, self.dim, &self.draw.params)?;

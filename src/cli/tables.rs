@@ -85,9 +85,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         (Some(name), _) => {
             let n = a.n.context("--sampler needs -n")?;
-            if a.draw.sets() == 0 {
-                bail!("--sets must be at least 1");
-            }
             let s = registry::build(name, n, a.dim, &a.draw.params)?;
             let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =
@@ -167,9 +164,6 @@ fn shard_path(output: &std::path::Path, shard: Shard) -> PathBuf {
 fn draw_table_shard(a: &Args, shard: Shard) -> anyhow::Result<()> {
     let name = a.sampler.as_deref().context("--shard needs --sampler")?;
     let n = a.n.context("--sampler needs -n")?;
-    if a.draw.sets() == 0 {
-        bail!("--sets must be at least 1");
-    }
     let sampler = registry::build(name, n, a.dim, &a.draw.params)?;
     let run = TableRun {
         sampler: name.to_string(),
