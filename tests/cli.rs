@@ -924,7 +924,6 @@ fn a_closed_standard_output_is_not_an_error() {
     // panicked with "failed printing to stdout: Broken pipe" and a
     // backtrace; CSV written through the csv crate (sample, pcf) lost the
     // error's kind and exited 1 with "Broken pipe".
-    use std::process::{Command, Stdio};
     for args in [
         &[
             "converge",
@@ -938,56 +937,51 @@ fn a_closed_standard_output_is_not_an_error() {
         &["sample", "random", "-n", "100000", "--sets", "4"],
         &["pcf", "--sampler", "jitter", "-n", "64", "--bins", "100000"],
     ] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_varspec"))
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        drop(child.stdout.take());
-        let out = child.wait_with_output().unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(out.status.success(), "{args:?}: {:?}: {err}", out.status);
-        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        with_stdout_closed(args);
     }
     // The files a command was asked for are written all the same (the
     // report and the curve were lost when the first print stopped it).
     let dir = temp_dir("closed-stdout");
     let p = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    with_stdout_closed(&[
+        "optimize",
+        "points",
+        "-n",
+        "64",
+        "--target",
+        "disk",
+        "--sets",
+        "1",
+        "--iters",
+        "20",
+        "-o",
+        &p("k.csv"),
+        "--report",
+        &p("k.json"),
+        "--curve",
+        &p("kc.csv"),
+    ]);
+    for name in ["k.csv", "k.json", "kc.csv"] {
+        assert!(dir.join(name).is_file(), "{name} not written");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Runs varspec with `args`, its standard output closed before it writes:
+/// it must succeed without a panic.
+fn with_stdout_closed(args: &[&str]) {
+    use std::process::{Command, Stdio};
     let mut child = Command::new(env!("CARGO_BIN_EXE_varspec"))
-        .args([
-            "optimize",
-            "points",
-            "-n",
-            "64",
-            "--target",
-            "disk",
-            "--sets",
-            "1",
-            "--iters",
-            "20",
-            "-o",
-            &p("k.csv"),
-            "--report",
-            &p("k.json"),
-            "--curve",
-            &p("kc.csv"),
-        ])
+        .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     drop(child.stdout.take());
     let out = child.wait_with_output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    for name in ["k.csv", "k.json", "kc.csv"] {
-        assert!(dir.join(name).is_file(), "{name} not written");
-    }
-    std::fs::remove_dir_all(&dir).unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?}: {:?}: {err}", out.status);
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
 }
 
 #[cfg(target_os = "linux")]
