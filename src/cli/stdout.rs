@@ -23,32 +23,24 @@ static STATE: Mutex<State> = Mutex::new(State::Open);
 
 /// Writes `args` and a newline to standard output (see the module docs).
 pub fn line(args: fmt::Arguments) {
-    let mut state = STATE
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    if !matches!(*state, State::Open) {
-        return;
-    }
-    let mut out = io::stdout().lock();
-    let written = out.write_fmt(args).and_then(|()| out.write_all(b"\n"));
-    if let Err(e) = written {
-        *state = if e.kind() == io::ErrorKind::BrokenPipe {
-            State::Closed
-        } else {
-            State::Failed(e)
-        };
-    }
+    write(|out| out.write_fmt(args).and_then(|()| out.write_all(b"\n")));
 }
 
 /// Writes `bytes` as they are (see [`line`]).
 pub fn bytes(bytes: &[u8]) {
+    write(|out| out.write_all(bytes));
+}
+
+/// Runs `put` on standard output while it is open, and records how a
+/// failed write leaves it.
+fn write(put: impl FnOnce(&mut io::StdoutLock) -> io::Result<()>) {
     let mut state = STATE
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     if !matches!(*state, State::Open) {
         return;
     }
-    if let Err(e) = io::stdout().lock().write_all(bytes) {
+    if let Err(e) = put(&mut io::stdout().lock()) {
         *state = if e.kind() == io::ErrorKind::BrokenPipe {
             State::Closed
         } else {
