@@ -22,9 +22,14 @@ pub fn clip(poly: &[[f64; 2]], n: [f64; 2], level: f64) -> Vec<[f64; 2]> {
     out
 }
 
-/// Area of a simple polygon (counter-clockwise positive).
+/// Area of a simple polygon (counter-clockwise positive); 0 for fewer
+/// than three vertices (an empty clip: std's empty float sum is −0, which
+/// printed as `I = -0`).
 pub fn shoelace(poly: &[[f64; 2]]) -> f64 {
     let n = poly.len();
+    if n < 3 {
+        return 0.0;
+    }
     0.5 * (0..n)
         .map(|i| {
             let (a, b) = (poly[i], poly[(i + 1) % n]);
@@ -35,3 +40,20 @@ pub fn shoelace(poly: &[[f64; 2]]) -> f64 {
 
 /// The unit square [0,1]², counter-clockwise.
 pub const UNIT_SQUARE: [[f64; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn areas_of_the_square_and_of_degenerate_polygons() {
+        assert_eq!(shoelace(&UNIT_SQUARE), 1.0);
+        for degenerate in [&[][..], &[[1.0, 1.0]], &[[0.0, 0.0], [1.0, 1.0]]] {
+            let area = shoelace(degenerate);
+            assert!(
+                area == 0.0 && area.is_sign_positive(),
+                "{degenerate:?}: {area}"
+            );
+        }
+    }
+}
