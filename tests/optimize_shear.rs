@@ -265,6 +265,14 @@ fn estimated_objective_matches_brute_force_variances() {
             49,
             vec![[0.0, 0.0], [0.45, 0.45], [-0.25, -0.25]],
         ),
+        // Both halves estimated: J and the (x, y) half's weights from one
+        // pass over the (u, v) realizations.
+        (
+            "defocus:shape=gaussian,size=0.4,c=-0.3",
+            "padded:xy=poisson-disk,uv=poisson-disk",
+            64,
+            vec![[0.0, 0.0], [0.3, 0.3]],
+        ),
     ] {
         assert_matches_brute_force(spec, sampler, n, &shears);
     }

@@ -455,11 +455,10 @@ impl<'a> ShearObjective<'a> {
         };
         if let UvPairs::Empirical(uv) = &self.uv {
             let (weighted, total) = sum_over_sets(
-                set.terms.len(),
+                &set,
                 &uv.sets,
-                &set.layer_sums,
                 |q, scratch, d| set.layer_sums.diagonals(q, scratch, d),
-                |d| crate::sum::sum(set.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)),
+                |_, d| crate::sum::sum(set.terms.iter().zip(d).map(|(t, d)| t.coefficient * d)),
             );
             let r = uv.sets.len() as f64;
             set.weighted_diagonal = weighted;
@@ -527,31 +526,33 @@ impl<'a> ShearObjective<'a> {
             .map_items(&items, |&(set, diagonal), scratch| {
                 let mut sums = vec![0.0; terms.terms.len()];
                 terms.layer_sums.power_sums(set, shear, scratch, &mut sums);
-                let power = terms
-                    .terms
-                    .iter()
-                    .zip(&sums)
-                    .map(|(t, p)| t.coefficient * p);
-                crate::sum::sum(power.chain([-diagonal]))
+                realization_part(terms, &sums, diagonal)
             })
     }
 
-    /// The mean over the (u, v) realizations of each term's pair sum.
-    fn mean_pair_sums(&self, uv: &UvRealizations, shear: [f64; 2]) -> Vec<f64> {
+    /// [`Self::per_realization`] of the full J and, from the same power
+    /// sums (one pass over the realizations, not two), the mean over the
+    /// (u, v) realizations of each term's pair sum, which an estimated
+    /// (x, y) half weighs.
+    fn per_realization_and_mean_pair_sums(
+        &self,
+        uv: &UvRealizations,
+        shear: [f64; 2],
+    ) -> (Vec<f64>, Vec<f64>) {
         let full = &self.full;
-        let (_, total) = sum_over_sets(
-            full.terms.len(),
+        let (per_set, total) = sum_over_sets(
+            full,
             &uv.sets,
-            &full.layer_sums,
             |set, scratch, sums| full.layer_sums.power_sums(set, shear, scratch, sums),
-            |_| 0.0,
+            |i, sums| realization_part(full, sums, full.weighted_diagonal[i]),
         );
         let r = uv.sets.len() as f64;
-        total
+        let mean = total
             .iter()
             .zip(&full.mean_diagonal)
             .map(|(t, d)| t / r - d)
-            .collect()
+            .collect();
+        (per_set, mean)
     }
 
     /// J at `shear` with its standard error: for an estimated half, the
@@ -573,10 +574,18 @@ impl<'a> ShearObjective<'a> {
     fn evaluate_parts(&self, [a, b]: [f64; 2]) -> Result<(f64, [f64; 2]), OptimizeError> {
         let base = self.variance / self.n as f64;
         let mut variances = [0.0; 2];
+        let xy_estimated = matches!(self.xy, XyPower::Empirical { .. });
+        let mut uv_mean_sums = None;
         let value = match &self.uv {
             UvPairs::Empirical(uv) => {
                 self.evaluations.fetch_add(1, Ordering::Relaxed);
-                let per_set = self.per_realization(&self.full, uv, [a, b]);
+                let per_set = if xy_estimated {
+                    let (per_set, mean_sums) = self.per_realization_and_mean_pair_sums(uv, [a, b]);
+                    uv_mean_sums = Some(mean_sums);
+                    per_set
+                } else {
+                    self.per_realization(&self.full, uv, [a, b])
+                };
                 variances[1] = sample_variance(&per_set) / per_set.len() as f64;
                 base + mean(&per_set)
             }
@@ -585,9 +594,10 @@ impl<'a> ShearObjective<'a> {
         if let XyPower::Empirical { freqs, sets, .. } = &self.xy {
             let n = self.n as f64;
             let scale = 2.0 / (n * n * (n - 1.0));
-            let uv_sums: Vec<f64> = match &self.uv {
-                UvPairs::Empirical(uv) => self.mean_pair_sums(uv, [a, b]),
-                UvPairs::Exact(uv) => self
+            let uv_sums: Vec<f64> = match (&self.uv, uv_mean_sums) {
+                (_, Some(mean_sums)) => mean_sums,
+                (UvPairs::Empirical(_), None) => unreachable!("computed with J above"),
+                (UvPairs::Exact(uv), None) => self
                     .full
                     .terms
                     .iter()
@@ -704,26 +714,33 @@ fn box_index(freqs: &FrequencyBox, k: [i64; 2]) -> usize {
     ((k[1] + h) * side + k[0] + h) as usize
 }
 
+/// J − Var f/N on one (u, v) realization from its power sums `sums` of
+/// the terms and its weighted diagonal.
+fn realization_part(terms: &TermSet, sums: &[f64], diagonal: f64) -> f64 {
+    let power = terms.terms.iter().zip(sums).map(|(t, p)| t.coefficient * p);
+    crate::sum::sum(power.chain([-diagonal]))
+}
+
 /// The per-term vectors `fill` writes for each of `sets`, summed over
-/// the sets, and `scalar` of each set's vector, in fixed chunks of
+/// the sets, and `scalar(index, vector)` of each set, in fixed chunks of
 /// [`CHUNK`] sets (memory: chunks × terms, not sets × terms; the same
-/// sums for any number of threads), the chunks run as `sums` runs its
-/// items ([`LayerSums::map_items`]).
+/// sums for any number of threads), the chunks run as the terms' layer
+/// sums run items ([`LayerSums::map_items`]).
 fn sum_over_sets(
-    terms: usize,
+    terms: &TermSet,
     sets: &[PointSet],
-    sums: &LayerSums,
     fill: impl Fn(&PointSet, &mut Scratch, &mut [f64]) + Sync,
-    scalar: impl Fn(&[f64]) -> f64 + Sync,
+    scalar: impl Fn(usize, &[f64]) -> f64 + Sync,
 ) -> (Vec<f64>, Vec<f64>) {
-    let chunks: Vec<&[PointSet]> = sets.chunks(CHUNK).collect();
-    let partial = sums.map_items(&chunks, |chunk, scratch| {
-        let mut v = vec![0.0; terms];
-        let mut total = vec![0.0; terms];
+    let len = terms.terms.len();
+    let chunks: Vec<(usize, &[PointSet])> = sets.chunks(CHUNK).enumerate().collect();
+    let partial = terms.layer_sums.map_items(&chunks, |&(c, chunk), scratch| {
+        let mut v = vec![0.0; len];
+        let mut total = vec![0.0; len];
         let mut scalars = Vec::with_capacity(chunk.len());
-        for set in chunk.iter() {
+        for (j, set) in chunk.iter().enumerate() {
             fill(set, scratch, &mut v);
-            scalars.push(scalar(&v));
+            scalars.push(scalar(c * CHUNK + j, &v));
             for (t, x) in total.iter_mut().zip(&v) {
                 *t += x;
             }
@@ -734,7 +751,7 @@ fn sum_over_sets(
         .iter()
         .flat_map(|(s, _)| s.iter().copied())
         .collect();
-    let total = (0..terms)
+    let total = (0..len)
         .map(|i| crate::sum::sum(partial.iter().map(|(_, t)| t[i])))
         .collect();
     (scalars, total)
