@@ -15,7 +15,7 @@ use crate::points::PointSet;
 use crate::rng::SetRng;
 use crate::samplers::config::Config;
 use crate::samplers::{Random, Sampler, SamplerError};
-use crate::square::design::{SquareTerm, default_options, design, parse_target};
+use crate::square::design::{SquareTerm, default_options, default_start, design, parse_target};
 
 /// The square's default target.
 pub const SQUARE_TARGET: &str = "halfplanes+gaussians+16*blue";
@@ -86,13 +86,8 @@ pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> 
             if let Some(i) = iters {
                 options.iters = i;
             }
-            // Jitter needs N = m²; CMJ stratifies any N the same way.
-            let start = match c.build_other("jitter", c.n, Some(2), &[]) {
-                Err(SamplerError::Count { .. }) => c.build_other("cmj", c.n, Some(2), &[])?,
-                other => other?,
-            };
             How::Square {
-                start,
+                start: c.build_other(default_start(c.n), c.n, Some(2), &[])?,
                 terms,
                 options,
             }

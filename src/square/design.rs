@@ -225,6 +225,13 @@ impl PointObjective for SquareObjective {
     }
 }
 
+/// The sampler a design on the square starts from by default: jitter
+/// where N is a square m², else CMJ, which stratifies any N the same way.
+pub fn default_start(n: usize) -> &'static str {
+    let m = (n as f64).sqrt().round() as usize;
+    if m * m == n { "jitter" } else { "cmj" }
+}
+
 /// Descent defaults for the square: 2000 Adam steps from 0.1 to 0.004 of
 /// the spacing, scored every 20 (measured in results/square: the
 /// half-plane MSE is within 2% of its 4000-step value at N = 1024 and 4096).
