@@ -49,7 +49,7 @@ pub struct SquareRequest {
     pub iters: Option<usize>,
     /// Seed of the starts and of the descent's members.
     pub seed: u64,
-    /// Starting sampler (default jitter).
+    /// Starting sampler (default: [`crate::square::design::default_start`]).
     pub init: Option<String>,
     /// Family members each score averages over.
     pub members: usize,
@@ -117,7 +117,10 @@ pub fn design_on_square(
     if let Some(i) = r.iters {
         options.iters = i;
     }
-    let init_name = r.init.clone().unwrap_or_else(|| "jitter".into());
+    let init_name = r
+        .init
+        .clone()
+        .unwrap_or_else(|| crate::square::design::default_start(r.n).into());
     let (init, n) = registry::build_nearest(&init_name, r.n, Some(2), &[])?;
     if n != r.n {
         return Err(SquareDesignError::Request(format!(
