@@ -92,7 +92,8 @@ pub struct PointsArgs {
     /// Sampler of the starting sets (default: lattice, the best integration
     /// lattice by the exact variance, for 2D integrands with a closed-form
     /// autocovariance; cmj for other 2D integrand targets; random for other
-    /// torus targets; umj for projection targets; jitter on the square).
+    /// torus targets; umj for projection targets; on the square jitter, or
+    /// cmj where N is not m²).
     /// `--sampler` as in every other command.
     #[arg(long, visible_alias = "sampler")]
     init: Option<String>,
@@ -180,18 +181,12 @@ enum DomainArg {
 }
 
 fn points(a: PointsArgs) -> anyhow::Result<()> {
-    args::check_outputs_beside(
-        [
-            Some(a.output.as_path()),
-            a.report.as_deref(),
-            a.curve.as_deref(),
-            a.curve_png.as_deref(),
-        ],
-        [a.init
-            .as_deref()
-            .map(std::path::Path::new)
-            .filter(|p| p.is_file())],
-    )?;
+    args::check_outputs([
+        Some(a.output.as_path()),
+        a.report.as_deref(),
+        a.curve.as_deref(),
+        a.curve_png.as_deref(),
+    ])?;
     varspec::memory::check(
         &format!("the results of {} designed sets of {} points", a.sets, a.n),
         Some(results_bytes(a.sets, a.n, a.dim, a.iters)),
