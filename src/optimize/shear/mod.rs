@@ -165,13 +165,19 @@ pub fn search_shear(
     let initial = clamp(start.shear);
     let initial_value = objective.value(initial[0], initial[1]);
     let mut best = ([0.0, 0.0], unsheared.value);
-    for c in start.candidates().into_iter().map(clamp) {
+    if initial_value < best.1 {
+        best = (initial, initial_value);
+    }
+    // The first candidate is the spectral start itself, J known above.
+    for c in start.candidates().into_iter().skip(1).map(clamp) {
         let v = objective.value(c[0], c[1]);
         if v < best.1 {
             best = (c, v);
         }
     }
-    let mut shear = best.0;
+    // J at `shear` is carried along (the lines return it): no evaluation
+    // repeats one already made.
+    let (mut shear, mut lined) = best;
     for along_a in [true, false] {
         let axis = usize::from(!along_a);
         stage(SearchStage::Line(axis));
@@ -180,11 +186,11 @@ pub fn search_shear(
             fixed: shear[1 - axis],
             along_a,
         };
-        let (t, _) = refine_line(&line, shear[axis], range)?;
+        let (t, value) = refine_line(&line, (shear[axis], lined), range)?;
         shear[axis] = t;
+        lined = value;
     }
     stage(SearchStage::Polish);
-    let lined = objective.value(shear[0], shear[1]);
     let step = 0.05 * SENSITIVITY_STEP;
     let simplex = vec![
         shear.to_vec(),
@@ -233,12 +239,16 @@ pub fn search_shear(
     })
 }
 
-/// Minimizes J along a line from `t0`: a scan of the whole range at step
+/// Minimizes J along a line from `t0`, where J is `value0`: a scan of the whole range at step
 /// [`COARSE_STEP`] on the coarse J ([`ShearObjective::coarse_value`]), J
 /// at its [`BASINS`] deepest local minima, a scan of ±10 points around the
 /// best at step 0.01, then Brent's method within one step of the best.
-fn refine_line(line: &Line, t0: f64, range: f64) -> Result<(f64, f64), OptimizeError> {
-    let mut best = (t0, line.at(t0));
+fn refine_line(
+    line: &Line,
+    (t0, value0): (f64, f64),
+    range: f64,
+) -> Result<(f64, f64), OptimizeError> {
+    let mut best = (t0, value0);
     let coarse = (range / COARSE_STEP).ceil() as i32;
     let scan: Vec<(f64, f64)> = (-coarse..=coarse)
         .map(|i| {
