@@ -150,6 +150,24 @@ fn a_rerun_keeps_the_notes_written_by_hand_below_the_marker() {
     run();
     let second = std::fs::read_to_string(out.join("README.md")).unwrap();
     assert_eq!(second, format!("{}\n\n{notes}", first.trim_end()));
+    // A sharded run keeps them too: a shard run cuts the README down to
+    // the notes and the merge puts the tables back above them.
+    let o = out.to_str().unwrap();
+    for shard in ["0/2", "1/2"] {
+        ok(&[
+            "experiment",
+            file.to_str().unwrap(),
+            "--shard",
+            shard,
+            "-o",
+            o,
+        ]);
+        let between = std::fs::read_to_string(out.join("README.md")).unwrap();
+        assert_eq!(between, notes, "a shard run left more than the notes");
+    }
+    ok(&["merge", o]);
+    let merged = std::fs::read_to_string(out.join("README.md")).unwrap();
+    assert_eq!(merged, second, "the merge lost the notes");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

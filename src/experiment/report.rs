@@ -303,12 +303,13 @@ pub(super) fn with_kept_notes(out: &Path, md: String) -> String {
 /// Removes what a run of the other kind left in `out`, so a folder never
 /// holds tables and shards of different runs side by side: a whole run
 /// (`shard` None) removes every `shard-*-of-*.json`; a shard run of a
-/// split into n removes the tables (README.md, variances.csv, slopes.csv:
-/// `merge` writes them again) and shards of other splits. Other files are
-/// left alone.
+/// split into n removes the tables (variances.csv, slopes.csv, …: `merge`
+/// writes them again) and shards of other splits, and cuts README.md down
+/// to its hand-written notes ([`KEPT_NOTES`]; removed if it has none), so
+/// the merge keeps them. Other files are left alone.
 ///
 /// # Errors
-/// The first file that could not be removed.
+/// The first file that could not be removed or rewritten.
 pub fn remove_other_runs(out: &Path, shard: Option<Shard>) -> Result<(), ExperimentError> {
     let Ok(entries) = std::fs::read_dir(out) else {
         return Ok(());
@@ -326,12 +327,22 @@ pub fn remove_other_runs(out: &Path, shard: Option<Shard>) -> Result<(), Experim
             (Some(_), None) => TABLES.contains(&name.as_str()),
             (None, None) => false,
         };
-        if stale {
-            std::fs::remove_file(entry.path()).map_err(|err| ExperimentError::Invalid {
-                file: out.display().to_string(),
-                reason: format!("removing the earlier run's {name}: {err}"),
-            })?;
+        if !stale {
+            continue;
         }
+        let notes = (name == "README.md")
+            .then(|| std::fs::read_to_string(entry.path()).ok())
+            .flatten()
+            .and_then(|old| old.find(KEPT_NOTES).map(|at| old[at..].to_owned()));
+        match notes {
+            Some(notes) => write_atomic(&entry.path(), |w| w.write_all(notes.as_bytes()))
+                .map_err(|err| err.to_string()),
+            None => std::fs::remove_file(entry.path()).map_err(|err| err.to_string()),
+        }
+        .map_err(|err| ExperimentError::Invalid {
+            file: out.display().to_string(),
+            reason: format!("removing the earlier run's {name}: {err}"),
+        })?;
     }
     Ok(())
 }
