@@ -196,7 +196,15 @@ fn spectrum_output_does_not_depend_on_thread_count() {
         "--seed",
         "9",
     ];
-    let run = |threads| varspec_with(&args, Some(threads)).stdout;
+    let run = |threads| {
+        let out = varspec_with(&args, Some(threads));
+        assert!(
+            out.status.success() && !out.stdout.is_empty(),
+            "{threads} threads: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out.stdout
+    };
     assert_eq!(run("1"), run("2"));
 }
 

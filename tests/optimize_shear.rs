@@ -129,7 +129,14 @@ fn search_finds_the_light_field_shear_with_its_sign() {
             "{spec} N={n}: variance {:e} above 1.15x the analytic shear's {analytic:e}",
             found.optimum.value
         );
-        assert!(found.optimum.value <= found.unsheared.value);
+        // A gain (≥ 1.1x: apertures as small as 0.04 gain 1.3x at N = 256, the analytic shear alike), against J at (0, 0) evaluated here
+        // rather than the search's own fallback value.
+        let unsheared = objective.value(0.0, 0.0);
+        assert!(
+            !found.kept_unsheared && found.optimum.value <= 0.9 * unsheared,
+            "{spec} N={n}: variance {:e} not 0.9x below the unsheared {unsheared:e}",
+            found.optimum.value
+        );
         // Sharper than its neighbourhood: the optimum is a minimum.
         assert!(found.sensitivity.iter().all(|&v| v >= found.optimum.value));
     }
@@ -174,7 +181,15 @@ fn no_shear_is_kept_when_nothing_is_better() {
         "{:?}",
         found.shear
     );
-    assert!(found.optimum.value <= found.unsheared.value);
+    // Either (0, 0) itself or a shear within 1e-3 of it that J cannot
+    // tell from it: never a variance above the unsheared one.
+    let unsheared = objective.value(0.0, 0.0);
+    assert!(
+        found.kept_unsheared || found.optimum.value <= unsheared * (1.0 + 1e-9),
+        "kept {:e} at {:?} against the unsheared {unsheared:e}",
+        found.optimum.value,
+        found.shear
+    );
     assert!(search_shear(&objective, &start, f64::INFINITY, &|_| {}).is_err());
     assert!(search_shear(&objective, &start, 0.0, &|_| {}).is_err());
 }
@@ -201,7 +216,6 @@ fn double_wedges_are_told_from_single_layers() {
         let f = integrands::parse(spec).unwrap();
         let start = spectral_start(f.as_ref(), 64, 2.0);
         assert!(start.double_wedge, "{spec}: {:?}", start.planes[0]);
-        // The best single shear is never worse than none.
         let s = registry::build("umj", 64, Some(4), &[]).unwrap();
         let objective = ShearObjective::new(
             f.as_ref(),
@@ -211,7 +225,21 @@ fn double_wedges_are_told_from_single_layers() {
         )
         .unwrap();
         let found = search_shear(&objective, &start, 2.0, &|_| {}).unwrap();
-        assert!(found.optimum.value <= found.unsheared.value, "{spec}");
+        // The best single shear: no point of a 0.1 grid over [−1, 1]²,
+        // evaluated here, is lower (the layers' own shears and (0, 0)
+        // among them; with two planes the best may lie between them).
+        let grid = (-10..=10)
+            .flat_map(|i| (-10..=10).map(move |j| [0.1 * f64::from(i), 0.1 * f64::from(j)]));
+        let (best, at) = grid
+            .map(|p| (objective.value(p[0], p[1]), p))
+            .min_by(|x, y| x.0.total_cmp(&y.0))
+            .unwrap();
+        assert!(
+            found.optimum.value <= best * (1.0 + 1e-9),
+            "{spec}: J {:e} at {:?} above the grid's {best:e} at {at:?}",
+            found.optimum.value,
+            found.shear
+        );
     }
 }
 
