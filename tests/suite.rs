@@ -35,6 +35,7 @@ mod seed_figures;
 mod source;
 mod spectrum_accuracy;
 mod square;
+mod standard_errors;
 mod tables;
 mod unbiasedness;
 mod variance_agreement;

@@ -1,0 +1,126 @@
+//! The standard errors the predictors report, checked against the spread of
+//! independent replicates. Other tests take these standard errors as their
+//! tolerances; here they are pinned by numbers the code under test does not
+//! produce: K replicates of an estimate, each from its own seed, give a
+//! sample variance s² of the values, which the mean reported squared
+//! standard error must match within the sampling error of s² itself,
+//! √(2/(K − 1) + γ₂/K) relative (γ₂ the values' excess kurtosis, measured
+//! from the replicates), at 3.29 of those (two-sided 99.9%). An inflated
+//! standard error, which would let every test that leans on it pass, fails
+//! here, and so does one too small.
+
+use varspec::integrands::{self, Integrand};
+use varspec::optimize::shear::{ObjectiveOptions, ShearObjective};
+use varspec::registry;
+use varspec::rng::set_rng;
+use varspec::variance::{VarianceError, empirical_shifting, fourier, spatial};
+
+/// Two-sided 99.9% normal quantile.
+const Z999: f64 = 3.29;
+
+/// Checks `(value, reported stderr)` pairs of independent replicates.
+fn assert_spread_matches(label: &str, replicates: &[(f64, f64)]) {
+    let k = replicates.len() as f64;
+    let mean = replicates.iter().map(|r| r.0).sum::<f64>() / k;
+    let m2 = replicates.iter().map(|r| (r.0 - mean).powi(2)).sum::<f64>() / k;
+    let m4 = replicates.iter().map(|r| (r.0 - mean).powi(4)).sum::<f64>() / k;
+    let s2 = m2 * k / (k - 1.0);
+    let excess_kurtosis = m4 / (m2 * m2) - 3.0;
+    let reported = replicates.iter().map(|r| r.1 * r.1).sum::<f64>() / k;
+    let relative_se = (2.0 / (k - 1.0) + excess_kurtosis.max(0.0) / k).sqrt();
+    let z = (s2 / reported - 1.0) / relative_se;
+    assert!(
+        z.abs() <= Z999,
+        "{label}: replicates' variance {s2:.4e} vs mean reported stderr² {reported:.4e} \
+         (ratio {:.3}, 99.9% interval 1 ± {:.3}; {} replicates)",
+        s2 / reported,
+        Z999 * relative_se,
+        replicates.len()
+    );
+}
+
+#[test]
+fn empirical_standard_error_and_interval_match_replicates() {
+    // Random points under a uniform shift are iid: the true variance of Î
+    // is Var f / N exactly, with Var f = A(1 − A) for a disk of area A.
+    let f = integrands::parse("disk:r=0.3,cx=0.4").unwrap();
+    let area = std::f64::consts::PI * 0.09;
+    let truth = area * (1.0 - area) / 64.0;
+    let random = registry::build("random", 64, Some(2), &[]).unwrap();
+    let jitter = registry::build("jitter", 64, Some(2), &[]).unwrap();
+    let (mut reps_random, mut reps_jitter, mut covered) = (Vec::new(), Vec::new(), 0usize);
+    let k = 400u64;
+    for rep in 0..k {
+        let e = empirical_shifting(f.as_ref(), 200, 1000 + rep, &[0, 1], |r| {
+            random.sample(&mut set_rng(7_000 + rep, r as u64))
+        })
+        .unwrap();
+        covered += usize::from(e.ci_low <= truth && truth <= e.ci_high);
+        reps_random.push((e.variance, e.stderr));
+        let e = empirical_shifting(f.as_ref(), 200, 5000 + rep, &[0, 1], |r| {
+            jitter.sample(&mut set_rng(9_000 + rep, r as u64))
+        })
+        .unwrap();
+        reps_jitter.push((e.variance, e.stderr));
+    }
+    assert_spread_matches("empirical, random", &reps_random);
+    assert_spread_matches("empirical, jitter", &reps_jitter);
+    // The 95% interval holds the truth in 95% of replicates: the count is
+    // Binomial(400, 0.95), sd 4.36, so 99.9% of counts lie in 380 ± 14.3.
+    let expected = 0.95 * k as f64;
+    let sd = (k as f64 * 0.95 * 0.05).sqrt();
+    assert!(
+        (covered as f64 - expected).abs() <= Z999 * sd,
+        "the 95% interval held Var f/N = {truth:e} in {covered} of {k} replicates \
+         (99.9% range {:.0}..{:.0})",
+        expected - Z999 * sd,
+        expected + Z999 * sd
+    );
+}
+
+#[test]
+fn spatial_and_fourier_standard_errors_match_replicates() {
+    let f = integrands::parse("box:w=0.4,h=0.2,angle=25").unwrap();
+    let cmj = registry::build("cmj", 64, Some(2), &[]).unwrap();
+    let realization = |rep: u64| {
+        let cmj = &cmj;
+        move |r: usize| -> Result<_, VarianceError> { Ok(cmj.sample(&mut set_rng(rep, r as u64))?) }
+    };
+    let (mut reps_spatial, mut reps_fourier) = (Vec::new(), Vec::new());
+    for rep in 0..200 {
+        let s = spatial(f.as_ref(), 8, realization(rep)).unwrap();
+        reps_spatial.push((s.variance, s.stderr));
+        let four = fourier(f.as_ref(), 16, 1e-9, 8, realization(100_000 + rep)).unwrap();
+        reps_fourier.push((four.variance, four.stderr));
+    }
+    assert_spread_matches("spatial, cmj", &reps_spatial);
+    assert_spread_matches("fourier, cmj", &reps_fourier);
+}
+
+#[test]
+fn the_shear_objective_standard_error_matches_replicates() {
+    // Poisson disk on (u, v) has no closed form: that half of J is
+    // estimated from realizations drawn with the options' seed.
+    let f: Box<dyn Integrand> = integrands::parse("defocus:shape=disk,size=0.3,c=0.4").unwrap();
+    let s = registry::build("padded:xy=cmj,uv=poisson-disk", 64, Some(4), &[]).unwrap();
+    let replicates: Vec<(f64, f64)> = (0..128)
+        .map(|seed| {
+            let options = ObjectiveOptions {
+                truncation: 0.1,
+                min_realizations: 32,
+                max_realizations: 32,
+                seed,
+                ..ObjectiveOptions::default()
+            };
+            let objective =
+                ShearObjective::new(f.as_ref(), s.as_ref(), &[[-0.4, -0.4]], options).unwrap();
+            let e = objective.evaluate([-0.2, -0.3]).unwrap();
+            (e.value, e.stderr)
+        })
+        .collect();
+    assert!(
+        replicates.iter().all(|r| r.1 > 0.0),
+        "the half is estimated"
+    );
+    assert_spread_matches("shear objective, padded cmj/poisson-disk", &replicates);
+}
