@@ -530,14 +530,18 @@ fn the_main_job_writes_a_self_contained_report() {
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
     let rows = report["predict"]["rows"].as_array().unwrap();
-    // The three predictors agree: spatial within the empirical CI for jitter.
+    // The three predictors agree: spatial, and Fourier up to its
+    // truncation bound, within the empirical 95% CI for jitter.
     let jitter = &rows[1];
     assert_eq!(jitter["sampler"], "jitter");
-    let spatial = jitter["spatial"].as_f64().unwrap();
+    let value = |key: &str| jitter[key].as_f64().unwrap();
+    let (low, high) = (value("ci_low"), value("ci_high"));
+    let spatial = value("spatial");
+    assert!(low <= spatial && spatial <= high, "spatial: {jitter}");
+    let (fourier, bound) = (value("fourier"), value("truncation_bound"));
     assert!(
-        jitter["ci_low"].as_f64().unwrap() <= spatial
-            && spatial <= jitter["ci_high"].as_f64().unwrap(),
-        "{jitter}"
+        bound <= 0.1 * fourier && low - bound <= fourier && fourier <= high + bound,
+        "fourier: {jitter}"
     );
     // The commands the page prints give its numbers: run them (file names
     // moved into the test's folder, --json where the numbers are printed).

@@ -59,6 +59,12 @@ fn slopes_match_the_theory_table() {
         let f = integrands::parse(spec).unwrap();
         let theory = theoretical_rate(sampler, f.class(), 2).expect("the table covers these");
         let (slope, (lo, hi)) = slope_ci(sampler, f.as_ref());
+        // Narrow enough to mean something: a noisy fit's wide interval
+        // would hold any theory (widest measured: Poisson disk, 0.30).
+        assert!(
+            hi - lo <= 0.35,
+            "{sampler} on {spec}: slope {slope:.3}, 95% CI [{lo:.3}, {hi:.3}] wider than 0.35"
+        );
         assert!(
             lo <= theory && theory <= hi,
             "{sampler} on {spec}: slope {slope:.3}, 95% CI [{lo:.3}, {hi:.3}] misses theory {theory}"

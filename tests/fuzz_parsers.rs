@@ -46,3 +46,20 @@ fn every_parser_is_fuzzed_once() {
         "a target listed twice: {names:?}"
     );
 }
+
+/// The mutations start from valid inputs: were a format change to break the
+/// seeds, every mutation would stop at the first error and the fuzzing
+/// above would reach nothing deeper.
+#[test]
+fn every_seed_input_parses() {
+    for target in targets() {
+        for seed in &target.seeds {
+            assert!(
+                (target.run)(seed),
+                "{}: the seed input {:?} is refused",
+                target.name,
+                String::from_utf8_lossy(seed)
+            );
+        }
+    }
+}

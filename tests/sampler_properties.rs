@@ -1,6 +1,6 @@
 //! Structural properties of every sampler (docs/architecture.md, "Conventions"): strata, N-rooks
 //! intervals, Poisson-disk distances, net intervals; checked on random seeds
-//! and sizes by proptest.
+//! and sizes drawn by proptest from one fixed seed.
 
 use proptest::prelude::*;
 use std::collections::HashSet;
@@ -59,7 +59,13 @@ fn is_multijittered(set: &PointSet, x: usize, y: usize) -> bool {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(64))]
+    // A fixed seed: a failure in CI is the same failure on any machine
+    // (no regression files to commit).
+    #![proptest_config(ProptestConfig {
+        cases: 64,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x5a3d_1e5e),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn jitter_has_one_point_per_stratum(seed: u64, m in 1usize..12, d in 1usize..4) {

@@ -730,6 +730,7 @@ mod tests {
         };
         let one = on(1).remove(0);
         let three = on(3).remove(0);
+        assert!(!one.is_empty() && one.len() == three.len());
         assert!(
             one.iter()
                 .zip(&three)
