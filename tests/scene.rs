@@ -135,6 +135,45 @@ fn edge_pixel(depth: f64, focus: f64, aperture: f64, edge: f64, px: usize) -> f6
     fraction_below(c0, cx, cu, edge)
 }
 
+/// The variance maps, which the tests below take as standard errors, are
+/// the renders' sample mean and variance: recomputed here from the renders
+/// themselves by the two-pass formula.
+#[test]
+fn the_variance_maps_are_the_renders_sample_mean_and_variance() {
+    use varspec::scene::analysis::SampleShear;
+    use varspec::scene::render::{render, render_variance};
+    let scene = edge_scene(6.0, 3.0, 0.3, 0.05);
+    let sampler = registry::build("umj", 16, Some(4), &[]).unwrap();
+    let shears = vec![SampleShear::NONE; 64];
+    let renders = 9;
+    let maps = render_variance(&scene, sampler.as_ref(), &shears, 21, renders, &|| {}).unwrap();
+    let images: Vec<Vec<f64>> = (0..renders as u64)
+        .map(|r| {
+            render(&scene, sampler.as_ref(), &shears, 21, r)
+                .unwrap()
+                .pixels
+        })
+        .collect();
+    let mut varying = 0;
+    for i in 0..64 {
+        let values: Vec<f64> = images.iter().map(|img| img[i]).collect();
+        let mean = values.iter().sum::<f64>() / renders as f64;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (renders - 1) as f64;
+        varying += usize::from(var > 0.0);
+        assert!(
+            (maps.mean.pixels[i] - mean).abs() <= 1e-14
+                && (maps.variance.pixels[i] - var).abs() <= 1e-12 * var.max(1e-12),
+            "pixel {i}: maps ({}, {}) vs renders ({mean}, {var})",
+            maps.mean.pixels[i],
+            maps.variance.pixels[i]
+        );
+    }
+    assert!(
+        varying >= 8,
+        "only {varying} pixels vary: the edge must be in view"
+    );
+}
+
 #[test]
 fn a_defocused_edge_matches_its_closed_form_for_every_sampler_and_shear() {
     use varspec::scene::analysis::SampleShear;

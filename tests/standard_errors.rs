@@ -124,3 +124,24 @@ fn the_shear_objective_standard_error_matches_replicates() {
     );
     assert_spread_matches("shear objective, padded cmj/poisson-disk", &replicates);
 }
+
+#[test]
+fn the_square_family_mse_standard_error_matches_replicates() {
+    // The sets held fixed, the members drawn anew: the standard error is
+    // over the members.
+    use varspec::square::{Family, family_mse};
+    let sampler = registry::build("jitter", 64, Some(2), &[]).unwrap();
+    let sets: Vec<_> = (0..4)
+        .map(|r| sampler.sample(&mut set_rng(31, r)).unwrap())
+        .collect();
+    for family in ["halfplanes", "gaussians"] {
+        let family = Family::parse(family).unwrap();
+        let replicates: Vec<(f64, f64)> = (0..200)
+            .map(|seed| {
+                let m = family_mse(&sets, &family, 256, 50_000 + seed);
+                (m.mse, m.stderr)
+            })
+            .collect();
+        assert_spread_matches(&format!("family MSE, {}", family.spec()), &replicates);
+    }
+}
