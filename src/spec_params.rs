@@ -51,9 +51,45 @@ pub fn key_values(list: &str) -> Result<Vec<(&str, &str)>, ParamListError> {
         .collect()
 }
 
+/// A parameter value as a canonical spec writes it: the shortest decimal
+/// that reads back to the same f64, in exponent form (`1e-8`) where the
+/// plain form would spell out a run of zeros (below 1e-4 or from 1e15 on).
+/// The parsers read both forms.
+#[derive(Debug, Clone, Copy)]
+pub struct SpecValue(pub f64);
+
+impl std::fmt::Display for SpecValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a.is_finite() && a != 0.0 && !(1e-4..1e15).contains(&a) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spec_values_are_short_and_read_back_exactly() {
+        for (v, text) in [
+            (0.3, "0.3"),
+            (-0.15, "-0.15"),
+            (0.0, "0"),
+            (45.0, "45"),
+            (1e-4, "0.0001"),
+            (1e-8, "1e-8"),
+            (-2.5e-7, "-2.5e-7"),
+            (1e15, "1e15"),
+            (std::f64::consts::PI * 1e-16, "3.141592653589793e-16"),
+        ] {
+            assert_eq!(SpecValue(v).to_string(), text);
+            assert_eq!(text.parse::<f64>().unwrap().to_bits(), v.to_bits());
+        }
+    }
 
     #[test]
     fn pairs_in_order_trimmed() {

@@ -204,7 +204,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         source.name(),
         source.count_label(),
         if pixel { "≈" } else { "=" },
-        f.integral()
+        varspec::spec_params::SpecValue(f.integral())
     );
     for (key, extra) in [
         ("fourier", "truncation_bound"),

@@ -11,6 +11,7 @@ use rustfft::num_complex::Complex64;
 
 use super::{Disk, Gaussian, Integrand, IntegrandClass, IntegrandError, LightField, Rect, sinc_pi};
 use crate::points::wrap01;
+use crate::spec_params::SpecValue;
 
 /// The 2D shape g of a defocus light field.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -157,8 +158,8 @@ impl Integrand for Defocus {
         format!(
             "defocus:shape={},size={},c={}",
             self.shape_name(),
-            self.size,
-            self.c
+            SpecValue(self.size),
+            SpecValue(self.c)
         )
     }
 

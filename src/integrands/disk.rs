@@ -8,6 +8,7 @@
 use rustfft::num_complex::Complex64;
 
 use super::{Integrand, IntegrandClass, IntegrandError, nearest_image, sum_over_images};
+use crate::spec_params::SpecValue;
 use crate::spectrum::phase::exp_neg_2pi_i;
 
 /// Periodized disk indicator.
@@ -119,7 +120,9 @@ impl Integrand for Disk {
     fn spec(&self) -> String {
         format!(
             "disk:r={},cx={},cy={}",
-            self.r, self.centre[0], self.centre[1]
+            SpecValue(self.r),
+            SpecValue(self.centre[0]),
+            SpecValue(self.centre[1])
         )
     }
 }

@@ -12,6 +12,7 @@
 use rustfft::num_complex::Complex64;
 
 use super::{Integrand, IntegrandClass, nearest_image};
+use crate::spec_params::SpecValue;
 use crate::spectrum::phase::{exp_neg_2pi_i, reduced_phase};
 
 /// Exponents beyond this contribute below 1e-17 relative.
@@ -190,7 +191,11 @@ impl Integrand for Gaussian {
     fn spec(&self) -> String {
         format!(
             "gaussian:sx={},sy={},angle={},cx={},cy={}",
-            self.sx, self.sy, self.angle, self.centre[0], self.centre[1]
+            SpecValue(self.sx),
+            SpecValue(self.sy),
+            SpecValue(self.angle),
+            SpecValue(self.centre[0]),
+            SpecValue(self.centre[1])
         )
     }
 }

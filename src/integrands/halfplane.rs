@@ -13,6 +13,7 @@ use rustfft::num_complex::Complex64;
 
 use super::{Integrand, IntegrandClass, sinc_pi};
 use crate::polygon::{clip, shoelace};
+use crate::spec_params::SpecValue;
 use crate::spectrum::phase::exp_neg_2pi_i;
 
 /// Half-plane ∩ unit square indicator.
@@ -170,6 +171,10 @@ impl Integrand for HalfPlane {
     }
 
     fn spec(&self) -> String {
-        format!("halfplane:angle={},offset={}", self.angle, self.offset)
+        format!(
+            "halfplane:angle={},offset={}",
+            SpecValue(self.angle),
+            SpecValue(self.offset)
+        )
     }
 }

@@ -9,6 +9,7 @@ use std::sync::OnceLock;
 use rustfft::num_complex::Complex64;
 
 use super::{Defocus, DefocusShape, Integrand, IntegrandClass, LightField, sinc_pi};
+use crate::spec_params::SpecValue;
 
 /// Frequencies per axis of the series for the layers' cross term.
 const CROSS_HALF: i64 = 256;
@@ -119,10 +120,10 @@ impl Integrand for Layers {
         format!(
             "layers:shape={},size={},c1={},c2={},mix={}",
             self.layers[0].shape_name(),
-            self.layers[0].size(),
-            self.layers[0].shear(),
-            self.layers[1].shear(),
-            self.mix
+            SpecValue(self.layers[0].size()),
+            SpecValue(self.layers[0].shear()),
+            SpecValue(self.layers[1].shear()),
+            SpecValue(self.mix)
         )
     }
 

@@ -8,6 +8,7 @@
 use rustfft::num_complex::Complex64;
 
 use super::{Integrand, IntegrandClass, nearest_image, sinc_pi, sum_over_images};
+use crate::spec_params::SpecValue;
 use crate::spectrum::phase::exp_neg_2pi_i;
 
 /// Periodized rotated-rectangle indicator.
@@ -119,7 +120,11 @@ impl Integrand for Rect {
     fn spec(&self) -> String {
         format!(
             "box:w={},h={},cx={},cy={},angle={}",
-            self.w, self.h, self.centre[0], self.centre[1], self.angle
+            SpecValue(self.w),
+            SpecValue(self.h),
+            SpecValue(self.centre[0]),
+            SpecValue(self.centre[1]),
+            SpecValue(self.angle)
         )
     }
 }

@@ -21,6 +21,7 @@ use std::f64::consts::PI;
 
 use super::integrands::{Box2, Catalogue, Disk, Gaussian, HalfPlane, SquareIntegrand};
 use crate::rng::{SetRng, set_rng, uniform};
+use crate::spec_params::SpecValue;
 
 /// Stream offset of family members, apart from the samplers' draws of the
 /// same seed.
@@ -171,10 +172,18 @@ impl Family {
     /// The canonical spec.
     pub fn spec(&self) -> String {
         match self {
-            Family::Gaussians { vmin, vmax } => format!("gaussians:vmin={vmin},vmax={vmax}"),
+            Family::Gaussians { vmin, vmax } => format!(
+                "gaussians:vmin={},vmax={}",
+                SpecValue(*vmin),
+                SpecValue(*vmax)
+            ),
             Family::HalfPlanes => "halfplanes".into(),
-            Family::Disks { rmin, rmax } => format!("disks:rmin={rmin},rmax={rmax}"),
-            Family::Boxes { smin, smax } => format!("boxes:smin={smin},smax={smax}"),
+            Family::Disks { rmin, rmax } => {
+                format!("disks:rmin={},rmax={}", SpecValue(*rmin), SpecValue(*rmax))
+            }
+            Family::Boxes { smin, smax } => {
+                format!("boxes:smin={},smax={}", SpecValue(*smin), SpecValue(*smax))
+            }
             Family::Listed { path, .. } => format!("file:{path}"),
         }
     }
