@@ -261,8 +261,8 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                     })
                     .collect::<Vec<f64>>()
             });
-            let summed = |method: SumMethod| {
-                let sums = LayerSums::for_light_field(light, &ks, method);
+            let summed = |method: SumMethod| -> anyhow::Result<_> {
+                let sums = LayerSums::for_light_field(light, &ks, method)?;
                 let transforms = sums.transforms();
                 let (seconds, totals) = time(3, || {
                     let per_set = sums.pair_sums(&sets, shear);
@@ -270,7 +270,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                         .map(|i| per_set.iter().map(|p| p[i]).sum::<f64>())
                         .collect::<Vec<f64>>()
                 });
-                (seconds, totals, transforms)
+                Ok((seconds, totals, transforms))
             };
             let bound = |w: &[PlaneWave]| {
                 let a: f64 = w.iter().map(|w| w.amplitude.norm()).sum();
@@ -285,7 +285,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                     .fold(0.0, f64::max)
             };
             let case = format!("{spec}, N={n}");
-            let (powers_seconds, powers, _) = summed(SumMethod::Powers);
+            let (powers_seconds, powers, _) = summed(SumMethod::Powers)?;
             let mut methods = vec![
                 ("direct".to_string(), direct_seconds, 0.0),
                 ("powers".to_string(), powers_seconds, error(&powers)),
@@ -295,7 +295,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                 1e-6,
                 varspec::optimize::shear::layer_sums::TRANSFORM_TOLERANCE,
             ] {
-                let (seconds, sums, transforms) = summed(SumMethod::Transform { tolerance });
+                let (seconds, sums, transforms) = summed(SumMethod::Transform { tolerance })?;
                 // `refused`: the memory budget refused the grids; powers ran.
                 let name = if transforms { "nufft" } else { "refused" };
                 methods.push((format!("{name} {tolerance:.0e}"), seconds, error(&sums)));

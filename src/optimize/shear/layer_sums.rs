@@ -34,9 +34,9 @@ use rustfft::num_complex::Complex64;
 
 use crate::integrands::LightField;
 use crate::points::{PointSet, wrap01};
-use crate::spectrum::FrequencyBox;
 use crate::spectrum::nufft::{NufftPlan, NufftScratch, Sign, Upsampling};
 use crate::spectrum::pair::turn;
+use crate::spectrum::{FrequencyBox, SpectrumError};
 
 /// Relative tolerance ε of the box transform: |ΔS(k)| ≤ ε·N (Barnett,
 /// Magland & af Klinteberg 2019, §3), where the pair sums J needs are of
@@ -154,9 +154,10 @@ impl LayerSums {
     /// `ks` in the order of (k_x, k_y), each with k_x ≥ 0, and the
     /// amplitudes of its waves (one per slope), summed by `method`.
     ///
-    /// A transform the NUFFT refuses (tolerance outside [1e-14, 0.1],
-    /// grids past the memory budget) leaves every term to the powers
-    /// ([`LayerSums::transforms`] says which).
+    /// # Errors
+    /// The NUFFT's refusal of a transform the method asks for or the cost
+    /// model picks (a tolerance outside [1e-14, 0.1], grids past the memory
+    /// budget).
     ///
     /// # Panics
     /// If `ks` is not sorted with k_x ≥ 0 or the amplitudes are not one per
@@ -166,7 +167,7 @@ impl LayerSums {
         amplitudes: Vec<Complex64>,
         slopes: Vec<[f64; 2]>,
         method: SumMethod,
-    ) -> Self {
+    ) -> Result<Self, SpectrumError> {
         assert!(
             ks.windows(2).all(|w| w[0] < w[1]) && ks.iter().all(|k| k[0] >= 0),
             "layer sums need distinct frequencies sorted by (k_x, k_y) with k_x >= 0"
@@ -176,7 +177,7 @@ impl LayerSums {
             ks.len() * slopes.len(),
             "one amplitude per wave"
         );
-        let transform = box_transform(ks, method);
+        let transform = box_transform(ks, method)?;
         let by_powers: Vec<usize> = match &transform {
             Some(t) => {
                 let mut in_box = vec![false; ks.len()];
@@ -214,7 +215,7 @@ impl LayerSums {
                 }),
             }
         }
-        LayerSums {
+        Ok(LayerSums {
             runs,
             e_rows,
             f_rows,
@@ -223,15 +224,22 @@ impl LayerSums {
             amplitudes,
             transform,
             kept: std::sync::Mutex::default(),
-        }
+        })
     }
 
     /// The terms of light field `light` at the frequencies `ks` (k_x ≥ 0,
     /// sorted by (k_x, k_y)), summed by `method`.
     ///
+    /// # Errors
+    /// As [`LayerSums::new`].
+    ///
     /// # Panics
     /// If `ks` is not sorted with k_x ≥ 0.
-    pub fn for_light_field(light: &dyn LightField, ks: &[[i64; 2]], method: SumMethod) -> Self {
+    pub fn for_light_field(
+        light: &dyn LightField,
+        ks: &[[i64; 2]],
+        method: SumMethod,
+    ) -> Result<Self, SpectrumError> {
         let mut amplitudes = Vec::new();
         for &k in ks {
             light.wave_amplitudes(k, &mut amplitudes);
@@ -466,28 +474,37 @@ impl LayerSums {
 
 /// The transform for the terms of `ks` in the box of its off-axis terms,
 /// when `method` asks for one (or the cost model prefers it).
-fn box_transform(ks: &[[i64; 2]], method: SumMethod) -> Option<BoxTransform> {
-    let half = ks
+fn box_transform(
+    ks: &[[i64; 2]],
+    method: SumMethod,
+) -> Result<Option<BoxTransform>, SpectrumError> {
+    let Some(half) = ks
         .iter()
         .filter(|k| k[0] != 0 && k[1] != 0)
         .map(|k| k[0].max(k[1].abs()))
-        .max()? as usize;
+        .max()
+    else {
+        return Ok(None);
+    };
+    let half = half as usize;
     let in_box = |k: &[i64; 2]| k[0].max(k[1].abs()) as usize <= half;
     let freqs = FrequencyBox { dim: 2, half };
     let (tolerance, points) = match method {
-        SumMethod::Powers => return None,
+        SumMethod::Powers => return Ok(None),
         SumMethod::Transform { tolerance } => (tolerance, 0),
         // Dot products cheaper than a transform's overhead alone: no plan.
         SumMethod::Auto { points }
             if DOT_NS * (ks.len() * points) as f64 <= TRANSFORM_OVERHEAD_NS =>
         {
-            return None;
+            return Ok(None);
         }
         SumMethod::Auto { points } => (TRANSFORM_TOLERANCE, points),
     };
-    // Refused (a tolerance out of range, or grids past the memory budget):
-    // the powers sum every term.
-    let plan = NufftPlan::with_upsampling(freqs, tolerance, Upsampling::Auto { points }).ok()?;
+    // A refusal (a tolerance out of range, grids past the memory budget) is
+    // an error, not a quiet switch to the powers: the memory budget scales
+    // with the threads, and the method must not (the sums differ by the
+    // transform's tolerance).
+    let plan = NufftPlan::with_upsampling(freqs, tolerance, Upsampling::Auto { points })?;
     let side = freqs.side();
     let terms: Vec<(usize, usize)> = ks
         .iter()
@@ -505,10 +522,10 @@ fn box_transform(ks: &[[i64; 2]], method: SumMethod) -> Option<BoxTransform> {
             + FFT_NS * cells * cells.log2()
             + TRANSFORM_OVERHEAD_NS;
         if DOT_NS * terms.len() as f64 * n <= transform {
-            return None;
+            return Ok(None);
         }
     }
-    Some(BoxTransform { plan, terms })
+    Ok(Some(BoxTransform { plan, terms }))
 }
 
 /// The tables' size per thread that sets the points per block: whole sets
@@ -637,7 +654,8 @@ mod tests {
         let amplitudes: Vec<Complex64> = (0..ks.len() * slopes.len())
             .map(|_| Complex64::new(uniform(&mut rng) - 0.5, uniform(&mut rng) - 0.5))
             .collect();
-        let sums = LayerSums::new(&ks, amplitudes.clone(), slopes.clone(), SumMethod::Powers);
+        let sums =
+            LayerSums::new(&ks, amplitudes.clone(), slopes.clone(), SumMethod::Powers).unwrap();
         assert!(sums.points_per_block() < 97, "{}", sums.points_per_block());
         // The box |k|∞ ≤ 9 by a transform at 1e-12, the axes beyond by powers.
         let transformed = LayerSums::new(
@@ -645,8 +663,20 @@ mod tests {
             amplitudes.clone(),
             slopes.clone(),
             SumMethod::Transform { tolerance: 1e-12 },
-        );
+        )
+        .unwrap();
         assert!(transformed.transforms() && !sums.transforms());
+        // A transform the NUFFT refuses is an error, never a quiet switch
+        // to the powers (whose sums differ in the last bits).
+        assert!(matches!(
+            LayerSums::new(
+                &ks,
+                amplitudes.clone(),
+                slopes.clone(),
+                SumMethod::Transform { tolerance: 0.5 },
+            ),
+            Err(SpectrumError::Tolerance(_))
+        ));
         let direct = EmpiricalPairs::new(vec![set.clone()]);
         let shear = [-0.37, 1.21];
         let mut scratch = Scratch::default();
@@ -719,7 +749,8 @@ mod tests {
             amplitudes,
             slopes,
             SumMethod::Transform { tolerance: 1e-9 },
-        );
+        )
+        .unwrap();
         assert!(sums.transforms());
         let on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()

@@ -313,7 +313,7 @@ impl<'a> ShearObjective<'a> {
             XyPower::Exact => 64,
             XyPower::Empirical { freqs, .. } => freqs.half,
         };
-        self.full = self.term_set(light, exact_xy, &half_plane(first_half, axes(first_half)));
+        self.full = self.term_set(light, exact_xy, &half_plane(first_half, axes(first_half)))?;
         self.half = first_half;
         let reference = starts
             .iter()
@@ -393,8 +393,8 @@ impl<'a> ShearObjective<'a> {
             .take(COARSE_TERMS)
             .map(|&i| frequencies[i])
             .collect();
-        self.full = self.term_set(light, exact_xy, &kept);
-        self.coarse = self.term_set(light, exact_xy, &coarse);
+        self.full = self.term_set(light, exact_xy, &kept)?;
+        self.coarse = self.term_set(light, exact_xy, &coarse)?;
         self.half = half;
         self.truncation_bound = tail + dropped;
         Ok(())
@@ -416,7 +416,7 @@ impl<'a> ShearObjective<'a> {
         light: &dyn LightField,
         exact: Option<&dyn PairSpectrum>,
         ks: &[[i64; 2]],
-    ) -> TermSet {
+    ) -> Result<TermSet, OptimizeError> {
         let mut ks = ks.to_vec();
         ks.sort_unstable();
         let n = self.n as f64;
@@ -449,7 +449,7 @@ impl<'a> ShearObjective<'a> {
                 amplitudes,
                 light.wave_slopes(),
                 SumMethod::Auto { points: self.n },
-            ),
+            )?,
             weighted_diagonal: Vec::new(),
             mean_diagonal: Vec::new(),
         };
@@ -464,7 +464,7 @@ impl<'a> ShearObjective<'a> {
             set.weighted_diagonal = weighted;
             set.mean_diagonal = total.iter().map(|t| t / r).collect();
         }
-        set
+        Ok(set)
     }
 
     /// J(a, b).
