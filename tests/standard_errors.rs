@@ -87,7 +87,7 @@ fn spatial_and_fourier_standard_errors_match_replicates() {
         move |r: usize| -> Result<_, VarianceError> { Ok(cmj.sample(&mut set_rng(rep, r as u64))?) }
     };
     let (mut reps_spatial, mut reps_fourier) = (Vec::new(), Vec::new());
-    for rep in 0..200 {
+    for rep in 0..1000 {
         let s = spatial(f.as_ref(), 8, realization(rep)).unwrap();
         reps_spatial.push((s.variance, s.stderr));
         let four = fourier(f.as_ref(), 16, 1e-9, 8, realization(100_000 + rep)).unwrap();
