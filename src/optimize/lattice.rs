@@ -5,7 +5,7 @@
 //! is the randomly shifted lattice rule (Cranley & Patterson 1976; Sloan &
 //! Joe, "Lattice Methods for Multiple Integration", 1994, §2). Differences of
 //! its points are points of L, so the spatial form of the variance
-//! (docs/mathematics.md §3; Öztireli 2016, Eq. 9) collapses from N² terms
+//! (docs/mathematics.md §2; Öztireli 2016, Eq. 9) collapses from N² terms
 //! to N:
 //!
 //!   Var[Î] = (1/N²) Σ_i Σ_j c_f(x_i − x_j) = (1/N) Σ_(x ∈ L ∩ [0,1)²) c_f(x),

@@ -1,4 +1,4 @@
-//! Gaussian repulsion on the torus (Ahmed, Wonka et al. 2022, "Gaussian
+//! Gaussian repulsion on the torus (Ahmed, Ren & Wonka 2022, "Gaussian
 //! blue noise", ACM TOG 41(6)): E(X) = (1/N) Σ_(i≠j) exp(−|x_i − x_j|²/(2σ²))
 //! with toroidal distances and σ a fixed fraction of the hexagonal spacing
 //! d_hex = √(2/(√3 N)). Its minimizers are blue noise with a large closest
