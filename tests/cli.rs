@@ -529,6 +529,23 @@ fn the_main_job_writes_a_self_contained_report() {
     assert!(html.matches("data:image/png;base64,").count() >= 10);
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    // The summary line's square ratio is the design's half-plane MSE over
+    // CMJ's row (it once divided by the third row, jitter's).
+    let square = report["square"]["rows"].as_array().unwrap();
+    let halfplanes = |name: &str| {
+        square
+            .iter()
+            .find(|r| r["name"].as_str().unwrap().starts_with(name))
+            .unwrap_or_else(|| panic!("no {name} row: {square:?}"))["halfplanes"]
+            .as_f64()
+            .unwrap()
+    };
+    let ratio = halfplanes("designed") / halfplanes("cmj");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains(&format!("square design {ratio:.2}x CMJ")),
+        "{stdout} vs {ratio:.2}"
+    );
     let rows = report["predict"]["rows"].as_array().unwrap();
     // The three predictors agree: spatial, and Fourier up to its
     // truncation bound, within the empirical 95% CI for jitter.

@@ -56,7 +56,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         tour.seconds,
         tour.predict.integrand,
         tour.predict.n,
-        tour.square.rows[0].halfplanes / tour.square.rows[2].halfplanes,
+        tour.square.halfplanes_against("cmj").unwrap_or(f64::NAN),
         tour.shear.shear[0],
         tour.shear.shear[1],
         -tour.shear.analytic,

@@ -171,6 +171,15 @@ pub struct SquareSection {
     pub commands: Vec<String>,
 }
 
+impl SquareSection {
+    /// The design's half-plane MSE over that of the sampler `name` (None
+    /// if the section has no such row).
+    pub fn halfplanes_against(&self, name: &str) -> Option<f64> {
+        let other = self.rows.iter().find(|r| r.name == name)?;
+        Some(self.rows.first()?.halfplanes / other.halfplanes)
+    }
+}
+
 /// Section 3.
 #[derive(Debug, Clone, Serialize)]
 pub struct ShearSection {
