@@ -51,17 +51,6 @@ pub fn integrate_panels(a: f64, b: f64, panels: usize, g: impl Fn(f64) -> f64) -
         .sum()
 }
 
-/// ∫_a^b g(x) dx by q-point Gauss–Legendre quadrature.
-pub fn integrate(a: f64, b: f64, q: usize, g: impl Fn(f64) -> f64) -> f64 {
-    let (nodes, weights) = gauss_legendre(q);
-    let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
-    half * nodes
-        .iter()
-        .zip(&weights)
-        .map(|(z, w)| w * g(mid + half * z))
-        .sum::<f64>()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -78,11 +67,5 @@ mod tests {
     fn panels_integrate_oscillations() {
         let exact = (1.0 - (2.0 * 50.0f64).cos()) / 50.0; // ∫_0^2 sin(50x) dx
         assert!((integrate_panels(0.0, 2.0, 40, |x| (50.0 * x).sin()) - exact).abs() < 1e-13);
-    }
-
-    #[test]
-    fn integrates_on_an_interval() {
-        let v = integrate(0.05, 0.45, 20, |r| r * r);
-        assert!((v - (0.45f64.powi(3) - 0.05f64.powi(3)) / 3.0).abs() < 1e-15);
     }
 }

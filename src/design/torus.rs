@@ -264,11 +264,6 @@ impl TorusPlan {
         self.lattice.as_ref()
     }
 
-    /// The starting sampler's name.
-    pub fn init_name(&self) -> &str {
-        &self.init_name
-    }
-
     /// The optimizer (its box, loss and upsampling).
     pub fn optimizer(&self) -> &PointOptimizer {
         &self.optimizer

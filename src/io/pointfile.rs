@@ -67,16 +67,6 @@ pub enum PointFileError {
     },
 }
 
-impl PointFileError {
-    /// The 1-based line of a line error.
-    pub fn line(&self) -> Option<usize> {
-        match self {
-            PointFileError::Line { line, .. } => Some(*line),
-            _ => None,
-        }
-    }
-}
-
 /// The defect on one line of a point-set file.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LineProblem {

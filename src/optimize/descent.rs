@@ -254,11 +254,6 @@ impl PointOptimizer {
             * crate::sum::sum(self.weights.iter().copied())
     }
 
-    /// The weights W(k) in box order.
-    pub fn weights(&self) -> &[f64] {
-        &self.weights
-    }
-
     /// The box.
     pub fn frequencies(&self) -> &FrequencyBox {
         &self.freqs

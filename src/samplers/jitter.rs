@@ -49,11 +49,6 @@ impl Jitter {
         super::check_size("jitter", n, dim, 1..=4)?;
         Ok(Jitter { m, dim, offset })
     }
-
-    /// Strata per axis.
-    pub fn strata_per_axis(&self) -> usize {
-        self.m
-    }
 }
 
 fn from_config(c: &Config, offset: StratumOffset) -> Result<Box<dyn Sampler>, SamplerError> {

@@ -28,9 +28,6 @@ pub enum SpectrumError {
     /// Transforms exist for d = 1..=4.
     #[error("spectra are computed in 1 to 4 dimensions, not {0} (project with --dims)")]
     UnsupportedDimension(usize),
-    /// Resolution below 2.
-    #[error("resolution {0} is too small: the box |k| < K/2 needs K >= 2")]
-    Resolution(usize),
     /// Point sets of another dimension than the transform.
     #[error("points are {found}-dimensional, the transform is {expected}-dimensional")]
     Dimension {

@@ -169,7 +169,6 @@ impl Upsampling {
 /// A designed transform for one frequency box and tolerance.
 pub struct NufftPlan {
     freqs: FrequencyBox,
-    tolerance: f64,
     /// Upsampling factor σ (2 or 5/4).
     sigma: f64,
     /// Fine grid points per axis.
@@ -250,7 +249,6 @@ impl NufftPlan {
         let inverse = planner.plan_fft(grid, FftDirection::Inverse);
         Ok(NufftPlan {
             freqs,
-            tolerance,
             sigma,
             grid,
             width,
@@ -268,11 +266,6 @@ impl NufftPlan {
         &self.freqs
     }
 
-    /// The requested tolerance ε.
-    pub fn tolerance(&self) -> f64 {
-        self.tolerance
-    }
-
     /// The upsampling factor σ in use.
     pub fn upsampling(&self) -> f64 {
         self.sigma
@@ -286,11 +279,6 @@ impl NufftPlan {
     /// Kernel width in grid points.
     pub fn kernel_width(&self) -> usize {
         self.width
-    }
-
-    /// Complex numbers of scratch one transform needs (two fine grids).
-    pub fn scratch_len(&self) -> usize {
-        2 * self.grid.pow(self.freqs.dim as u32)
     }
 
     /// Fresh scratch for this plan.

@@ -130,11 +130,6 @@ impl EmpiricalPairs {
         EmpiricalPairs { sets, n }
     }
 
-    /// Realizations R.
-    pub fn sets(&self) -> usize {
-        self.sets.len()
-    }
-
     /// Σ_(l≠m) e^(2πi(ω·q_l − ω′·q_m)) on set `r` alone, computed as
     /// (Σ_l e^(2πiω·q_l))·conj(Σ_m e^(2πiω′·q_m)) − Σ_l e^(2πi(ω−ω′)·q_l).
     pub fn pair_sum_of(&self, r: usize, w1: [f64; 2], w2: [f64; 2]) -> Complex64 {
