@@ -188,12 +188,17 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
             a.curve.as_deref(),
             a.curve_png.as_deref(),
         ],
-        target_files(&a.target).into_iter().map(Some),
+        varspec::optimize::target::files_read(&a.target)
+            .into_iter()
+            .map(Some),
     )?;
     varspec::memory::check(
-        &format!("the results of {} designed sets of {} points", a.sets, a.n),
+        &format!(
+            "the results of {} designed sets of {} points (with their loss curves)",
+            a.sets, a.n
+        ),
         Some(results_bytes(a.sets, a.n, a.dim, a.iters)),
-        "lower --sets",
+        "lower --sets or --iters",
     )?;
     if !(a.checkpoint_every >= 0.0 && a.checkpoint_every.is_finite()) {
         bail!(
@@ -437,21 +442,6 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
 
 /// `optimize points -d 4` with targets per projection: one 4D descent on
 /// the planes' spectral losses, from umj by default.
-/// The files a target reads: `radial:FILE` (alone or as a projection's
-/// `xu:radial:FILE` between `;`) and a square family's `file:PATH`
-/// (between `+`, after an optional `W*`), so that no output replaces them.
-fn target_files(spec: &str) -> Vec<&std::path::Path> {
-    spec.split([';', '+'])
-        .filter_map(|part| {
-            let part = part.split_once('*').map_or(part, |(_, family)| family);
-            ["radial:", "file:"]
-                .iter()
-                .find_map(|prefix| part.find(prefix).map(|at| &part[at + prefix.len()..]))
-        })
-        .map(|path| std::path::Path::new(path.trim()))
-        .collect()
-}
-
 fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     use varspec::design::projections::{ProjectionRequest, design_projections};
     let request = ProjectionRequest {

@@ -222,9 +222,47 @@ fn read_radial(path: &Path) -> Result<Vec<(f64, f64)>, String> {
     Ok(table.into_iter().map(|(k, w)| (k, w / largest)).collect())
 }
 
+/// The files a target spec of `optimize points` reads, whatever its
+/// domain: `radial:FILE` (a torus target, or a projection's
+/// `xu:radial:FILE` between `;`, see [`crate::optimize::projections`]) and
+/// a square family's `file:PATH` (a term between `+`, after an optional
+/// `W*`, see [`crate::square::design::parse_target`]). Callers keep their
+/// outputs off these files.
+pub fn files_read(spec: &str) -> Vec<&Path> {
+    spec.split([';', '+'])
+        .filter_map(|part| {
+            let part = part.split_once('*').map_or(part, |(_, family)| family);
+            ["radial:", "file:"]
+                .iter()
+                .find_map(|prefix| part.find(prefix).map(|at| &part[at + prefix.len()..]))
+        })
+        .map(|path| Path::new(path.trim()))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_files_a_target_reads_in_every_grammar() {
+        for (spec, files) in [
+            ("family:disks", vec![]),
+            ("radial:w.csv", vec!["w.csv"]),
+            (
+                "xu:radial:a.csv;yv:power:3;uv:radial:b.csv",
+                vec!["a.csv", "b.csv"],
+            ),
+            ("halfplanes+2*file:m.txt+16*blue", vec!["m.txt"]),
+            ("disk:r=0.3", vec![]),
+        ] {
+            let found: Vec<&str> = files_read(spec)
+                .iter()
+                .map(|p| p.to_str().unwrap())
+                .collect();
+            assert_eq!(found, files, "{spec}");
+        }
+    }
 
     #[test]
     fn disk_family_decays_like_k_cubed() {
