@@ -112,10 +112,32 @@ pub fn nearest_neighbour_distances(points: &PointSet) -> Vec<f64> {
         .collect()
 }
 
+/// The spacing √(2/(√3 N)) of N points on the unit torus in the densest
+/// packing, the hexagonal one (at least one point).
+pub fn hexagonal_spacing(n: usize) -> f64 {
+    packing_radius(n, 2).expect("defined in 2D")
+}
+
+/// The neighbour distance r_max of N points in the densest packing of the
+/// unit d-torus, from N·V_d·(r/2)^d = Δ_d with the packing density Δ_d of
+/// the integer (d = 1), hexagonal (2), face-centred cubic (3) and D4 (4)
+/// lattices: 1/N, √(2/(√3 N)), (√2/N)^(1/3), (2/N)^(1/4); None beyond
+/// four dimensions (at least one point).
+pub fn packing_radius(n: usize, dim: usize) -> Option<f64> {
+    let n = n.max(1) as f64;
+    match dim {
+        1 => Some(1.0 / n),
+        2 => Some((2.0 / (3f64.sqrt() * n)).sqrt()),
+        3 => Some((2f64.sqrt() / n).cbrt()),
+        4 => Some((2.0 / n).sqrt().sqrt()),
+        _ => None,
+    }
+}
+
 /// The closest pair of `set` (toroidal distance) over the hexagonal
-/// spacing √(2/(√3 N)), the densest packing's.
+/// spacing ([`hexagonal_spacing`]).
 pub fn closest_pair_ratio(set: &PointSet) -> f64 {
-    let hex = (2.0 / (3f64.sqrt() * set.len().max(1) as f64)).sqrt();
+    let hex = hexagonal_spacing(set.len());
     nearest_neighbour_distances(set)
         .into_iter()
         .fold(f64::INFINITY, f64::min)

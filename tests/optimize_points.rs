@@ -83,7 +83,7 @@ fn blue_noise_beats_jitter_on_unseen_disks_and_boxes() {
         mean <= 0.6,
         "mean variance ratio to jitter {mean:.3} (per integrand {ratios:.3?})"
     );
-    let r_max = varspec::samplers::packing_radius(n, 2);
+    let r_max = varspec::neighbours::hexagonal_spacing(n);
     let nn = varspec::neighbours::nearest_neighbour_distances(&result.points);
     let closest = nn.iter().copied().fold(f64::INFINITY, f64::min) / r_max;
     assert!(

@@ -1,8 +1,8 @@
 //! Pair correlation: white noise is 1, Poisson disk is empty below its radius.
 
+use varspec::neighbours::hexagonal_spacing;
 use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::packing_radius;
 use varspec::spectrum::pcf::pair_correlation;
 
 #[test]
@@ -11,7 +11,7 @@ fn random_points_have_unit_pair_correlation_within_ci() {
     // kernel-smoothed constant 1: Φ(r/σ) + (σ/r)φ(r/σ) in 2D, within 3e-7 of
     // 1 for r ≥ 5σ. Per-radius mean over 200 sets within z = 5 SE.
     let n = 512;
-    let sigma = 0.2 * packing_radius(n, 2);
+    let sigma = 0.2 * hexagonal_spacing(n);
     let sampler = registry::build("random", n, Some(2), &[]).unwrap();
     let per_set: Vec<Vec<f64>> = (0..200)
         .map(|r| {
@@ -47,7 +47,7 @@ fn poisson_disk_pair_correlation_vanishes_below_its_radius() {
     let sets: Vec<_> = (0..8)
         .map(|r| sampler.sample(&mut set_rng(4, r)).unwrap())
         .collect();
-    let r_min = 0.75 * packing_radius(n, 2);
+    let r_min = 0.75 * hexagonal_spacing(n);
     let sigma = 0.05 * r_min;
     let pcf = pair_correlation(&sets, 3.0 * r_min, 120, sigma).unwrap();
     for (&r, &g) in pcf.r.iter().zip(&pcf.g) {

@@ -5,10 +5,11 @@
 use proptest::prelude::*;
 use std::collections::HashSet;
 use varspec::PointSet;
+use varspec::neighbours::packing_radius;
 use varspec::points::toroidal_distance_sq;
 use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::samplers::{self, packing_radius};
+use varspec::samplers;
 
 fn draw(name: &str, n: usize, dim: usize, params: &[(&str, &str)], seed: u64) -> PointSet {
     let params: Vec<(String, String)> = params
@@ -153,7 +154,7 @@ proptest! {
     fn poisson_disk_keeps_its_minimum_distance(seed: u64, n in 1usize..400, d in 2usize..5, rho in 0.3f64..0.75) {
         let rho_text = rho.to_string();
         let set = draw("poisson-disk", n, d, &[("radius", &rho_text)], seed);
-        let r2 = (rho * packing_radius(n, d)).powi(2);
+        let r2 = (rho * packing_radius(n, d).unwrap()).powi(2);
         for i in 0..n {
             for k in 0..i {
                 let d2 = toroidal_distance_sq(set.point(i), set.point(k));

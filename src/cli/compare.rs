@@ -8,10 +8,11 @@ use anyhow::{Context, bail};
 
 use super::progress;
 use varspec::io::write_atomic;
+use varspec::neighbours::hexagonal_spacing;
 use varspec::neighbours::nearest_neighbour_distances;
 use varspec::registry;
 use varspec::report::png::{render_points, save_png};
-use varspec::samplers::{self, packing_radius};
+use varspec::samplers;
 
 /// The 2D samplers compared, in table order.
 const COMPARED: [&str; 10] = [
@@ -69,7 +70,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         // Lagae & Dutré (2008) relative radii: distances over the hexagonal
         // packing distance, the minimum (δ_min) and mean (δ̄) nearest-neighbour
         // distance, averaged over sets.
-        let r_max = packing_radius(n, 2);
+        let r_max = hexagonal_spacing(n);
         let (mut min_rel, mut mean_rel) = (0.0, 0.0);
         for set in &sets {
             let nn = nearest_neighbour_distances(set);

@@ -7,8 +7,8 @@ use anyhow::bail;
 use super::progress;
 use super::source::SourceArgs;
 use varspec::io::{write_atomic, write_csv_rows};
+use varspec::neighbours::packing_radius;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
-use varspec::samplers::packing_radius;
 use varspec::spectrum::pcf::pair_correlation;
 
 #[derive(clap::Args)]
@@ -61,10 +61,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .collect::<Result<Vec<_>, _>>()?;
     bar.finish_and_clear();
     let (n, d) = (sets[0].len(), sets[0].dim());
-    let unit = if d == 1 {
-        1.0 / n as f64
-    } else {
-        packing_radius(n, d.min(4))
+    let Some(unit) = packing_radius(n, d) else {
+        bail!("pair correlation covers 1 to 4 dimensions; the points are {d}-dimensional");
     };
     // The estimator needs (range + 6σ)·r_max < 1/2 (beyond, toroidal
     // distances alias): say so in the units the options are given in.

@@ -179,23 +179,4 @@ pub(crate) fn sum_over_images(h: &[f64], overlap: impl Fn([f64; 2]) -> f64) -> f
     total
 }
 
-/// sin(x)/x, 1 at 0.
-#[inline]
-pub(crate) fn sinc(x: f64) -> f64 {
-    if x.abs() < 1e-4 {
-        1.0 - x * x / 6.0
-    } else {
-        x.sin() / x
-    }
-}
-
-/// sin(πu)/(πu) for an exactly rounded u, reducing u modulo 2 exactly
-/// before the sine so large |u| keeps its accuracy.
-#[inline]
-pub(crate) fn sinc_pi(u: f64) -> f64 {
-    if u.abs() <= 1.0 {
-        return sinc(std::f64::consts::PI * u);
-    }
-    let r = u - 2.0 * (0.5 * u).round();
-    (std::f64::consts::PI * r).sin() / (std::f64::consts::PI * u)
-}
+pub(crate) use crate::spectrum::phase::sinc_pi;

@@ -5,7 +5,7 @@
 //! pair; as a term beside a family MSE it keeps a design blue.
 //! Pairs farther than 4σ (weight < 3.4e-4) are skipped via a cell grid.
 
-use crate::neighbours::CellGrid;
+use crate::neighbours::{CellGrid, hexagonal_spacing};
 use crate::points::PointSet;
 
 /// σ as a fraction of the hexagonal spacing.
@@ -14,7 +14,7 @@ pub const SIGMA_OVER_SPACING: f64 = 0.5;
 /// E(X), adding `weight`·∂E/∂x into `gradient` when given (2D).
 pub fn repulsion(points: &PointSet, weight: f64, gradient: Option<&mut [f64]>) -> f64 {
     let n = points.len();
-    let spacing = (2.0 / (3f64.sqrt() * n.max(1) as f64)).sqrt();
+    let spacing = hexagonal_spacing(n);
     let sigma = SIGMA_OVER_SPACING * spacing;
     let radius = (4.0 * sigma).min(0.49);
     let grid = CellGrid::new(points);
@@ -43,7 +43,7 @@ pub fn repulsion(points: &PointSet, weight: f64, gradient: Option<&mut [f64]>) -
 /// E for N uniform random points, (N − 1)·2πσ² (the Gaussian's integral
 /// over the plane; σ ≪ 1), the same for every N since σ² ∝ 1/N.
 pub fn uniform_energy(n: usize) -> f64 {
-    let spacing2 = 2.0 / (3f64.sqrt() * n.max(1) as f64);
+    let spacing2 = hexagonal_spacing(n).powi(2);
     let sigma2 = SIGMA_OVER_SPACING * SIGMA_OVER_SPACING * spacing2;
     (n.max(2) - 1) as f64 * 2.0 * std::f64::consts::PI * sigma2
 }

@@ -13,7 +13,8 @@ use super::config::{Config, integer_root, pow_saturating};
 use super::{Sampler, SamplerError};
 use crate::points::{PointSet, stratum_coord};
 use crate::rng::{SetRng, uniform};
-use crate::spectrum::pair::{PairSpectrum, geometric, turn, uniform_char};
+use crate::spectrum::pair::{PairSpectrum, geometric, uniform_char};
+use crate::spectrum::phase::turn;
 
 /// Where in its stratum each point lies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

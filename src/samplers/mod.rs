@@ -25,7 +25,7 @@ pub use jitter::{Jitter, StratumOffset};
 pub use multijitter::MultiJitter;
 pub use nrooks::NRooks;
 pub use padded::Padded;
-pub use poisson_disk::{PoissonDisk, packing_radius};
+pub use poisson_disk::PoissonDisk;
 pub use random::Random;
 pub use sobol::Sobol;
 

@@ -13,28 +13,12 @@
 
 use super::config::{Config, pow_saturating};
 use super::{Sampler, SamplerError};
+use crate::neighbours::packing_radius;
 use crate::points::{PointSet, toroidal_distance_sq};
 use crate::rng::{SetRng, uniform};
 
 /// Grids beyond this many cells are refused rather than allocated.
 const MAX_CELLS: usize = 1 << 28;
-
-/// The neighbour distance r_max of N points in the densest packing of the
-/// unit d-torus: from N·V_d·(r/2)^d = Δ_d with the packing density Δ_d of the
-/// hexagonal (d = 2), face-centred cubic (3) and D4 (4) lattices:
-/// 2D √(2/(√3 N)), 3D (√2/N)^(1/3), 4D (2/N)^(1/4).
-///
-/// # Panics
-/// For d outside 2..=4.
-pub fn packing_radius(n: usize, dim: usize) -> f64 {
-    let n = n as f64;
-    match dim {
-        2 => (2.0 / (3f64.sqrt() * n)).sqrt(),
-        3 => (2f64.sqrt() / n).cbrt(),
-        4 => (2.0 / n).sqrt().sqrt(),
-        _ => panic!("packing radius is defined here for d = 2, 3, 4, not {dim}"),
-    }
-}
 
 /// Exactly N points in d ∈ {2,3,4} dimensions, pairwise toroidal distance
 /// ≥ ρ·r_max.
@@ -104,7 +88,7 @@ impl PoissonDisk {
 
     /// The absolute minimum distance r = ρ·r_max.
     pub fn radius(&self) -> f64 {
-        self.rho * packing_radius(self.n, self.dim)
+        self.rho * packing_radius(self.n, self.dim).expect("d in 2..=4, checked when built")
     }
 
     /// Cells per axis: the most whose side 1/g is still ≥ r.

@@ -19,6 +19,7 @@
 use rustfft::num_complex::Complex64;
 
 use crate::points::PointSet;
+use crate::spectrum::phase::{sinc_pi, turn};
 
 /// One term A·e^(2πi ω·q) of a superposition of plane waves.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,26 +54,6 @@ pub trait PairSpectrum: Send + Sync {
     fn power(&self, k: [f64; 2]) -> f64 {
         1.0 + self.pair_sum(k, k).re / self.points() as f64
     }
-}
-
-/// e^(2πi t) for a real t, reduced modulo 1 first so large |t| keeps its
-/// accuracy.
-#[inline]
-pub fn turn(t: f64) -> Complex64 {
-    let r = t - t.round();
-    let (s, c) = (std::f64::consts::TAU * r).sin_cos();
-    Complex64::new(c, s)
-}
-
-/// sin(πz)/(πz), 1 at 0, with z reduced exactly modulo 2 for the sine.
-#[inline]
-fn sinc_pi(z: f64) -> f64 {
-    if z.abs() < 1e-5 {
-        let t = std::f64::consts::PI * z;
-        return 1.0 - t * t / 6.0;
-    }
-    let r = z - 2.0 * (0.5 * z).round();
-    (std::f64::consts::PI * r).sin() / (std::f64::consts::PI * z)
 }
 
 /// χ(w) = ∫₀¹ e^(2πiwt) dt = e^(πiw)·sinc(πw): the characteristic function

@@ -27,6 +27,30 @@ pub fn phasor(t: f64) -> Complex64 {
     Complex64::new(c, -s)
 }
 
+/// e^(2πi t) for a real t, reduced modulo 1 first (the conjugate of
+/// [`phasor`]).
+#[inline]
+pub fn turn(t: f64) -> Complex64 {
+    phasor(t).conj()
+}
+
+/// sin(πu)/(πu), 1 at 0 (a Taylor term for |πu| < 1e-4), with |u| > 1
+/// reduced modulo 2 before the sine, exactly, so large |u| keeps its
+/// accuracy.
+#[inline]
+pub fn sinc_pi(u: f64) -> f64 {
+    let pu = std::f64::consts::PI * u;
+    if u.abs() <= 1.0 {
+        return if pu.abs() < 1e-4 {
+            1.0 - pu * pu / 6.0
+        } else {
+            pu.sin() / pu
+        };
+    }
+    let r = u - 2.0 * (0.5 * u).round();
+    (std::f64::consts::PI * r).sin() / pu
+}
+
 /// e^(−2πi k·x) with exact phase reduction in every coordinate.
 pub fn exp_neg_2pi_i(k: &[i64], x: &[f64]) -> Complex64 {
     let t: f64 = k

@@ -35,7 +35,7 @@ use rustfft::num_complex::Complex64;
 use crate::integrands::LightField;
 use crate::points::{PointSet, wrap01};
 use crate::spectrum::nufft::{NufftPlan, NufftScratch, Sign, Upsampling};
-use crate::spectrum::pair::turn;
+use crate::spectrum::phase::turn;
 use crate::spectrum::{FrequencyBox, SpectrumError};
 
 /// Relative tolerance ε of the box transform: |ΔS(k)| ≤ ε·N (Barnett,
