@@ -265,15 +265,16 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
     out.insert("sets".into(), json!(sets.len()));
     out.insert(
         "brute_force".into(),
-        json!({"mse": brute.mse, "stderr": brute.stderr, "ci_low": (brute.mse - 1.96 * brute.stderr).max(0.0),
-               "ci_high": brute.mse + 1.96 * brute.stderr, "members": brute.members, "member_seed": seed,
+        json!({"mse": brute.mse, "stderr": brute.stderr, "ci_low": brute.interval_95().0,
+               "ci_high": brute.interval_95().1, "members": brute.members, "member_seed": seed,
                "seconds": start.elapsed().as_secs_f64()}),
     );
     // The closed form weighs points by 1/N: not for random-count sets.
     if family == Family::HalfPlanes && sets.iter().all(|s| s.density().is_none()) {
         let start = Instant::now();
         let q = 4096;
-        let closed = sets.iter().map(|s| halfplane_mse(s, q)).sum::<f64>() / sets.len() as f64;
+        let closed =
+            varspec::sum::sum(sets.iter().map(|s| halfplane_mse(s, q))) / sets.len() as f64;
         out.insert(
             "closed_form".into(),
             json!({"mse": closed, "directions": q, "seconds": start.elapsed().as_secs_f64()}),
@@ -293,8 +294,8 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
     outln!(
         "  brute force  {:.6e}  95% CI [{:.4e}, {:.4e}] over {} members",
         brute.mse,
-        (brute.mse - 1.96 * brute.stderr).max(0.0),
-        brute.mse + 1.96 * brute.stderr,
+        brute.interval_95().0,
+        brute.interval_95().1,
         brute.members
     );
     if let Some(v) = out.get("closed_form") {

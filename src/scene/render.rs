@@ -366,6 +366,6 @@ impl PixelStatistics {
 
 fn sample_variance(values: &[f64]) -> f64 {
     let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0)
+    let mean = crate::sum::sum(values.iter().copied()) / n;
+    crate::sum::sum(values.iter().map(|v| (v - mean) * (v - mean))) / (n - 1.0)
 }

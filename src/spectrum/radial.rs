@@ -4,7 +4,8 @@
 //! var/mean² of the power over the ring (an isotropic spectrum has about the
 //! periodogram noise 1/R for R realizations; in decibels, 10·log10 of it).
 
-use super::Spectrum;
+use super::{FrequencyBox, Spectrum};
+use crate::sum::NeumaierSum;
 
 /// One ring of a radial profile.
 #[derive(Debug, Clone, PartialEq)]
@@ -19,53 +20,75 @@ pub struct RadialBin {
     pub count: usize,
 }
 
-/// The radial profile of a spectrum for rings 1..=h (only rings that lie
-/// wholly in the box), from two passes over the box: means, then centred
-/// squares (no E[X²] − E[X]² cancellation).
-pub fn radial_profile(spectrum: &Spectrum) -> Vec<RadialBin> {
-    let freqs = spectrum.freqs;
-    let h = freqs.half;
-    let ring_of = |idx: usize, k: &mut [i64]| {
-        freqs.frequency(idx, k);
-        let r2: i64 = k.iter().map(|v| v * v).sum();
-        (r2 as f64).sqrt().round() as usize
-    };
+/// The values of one ring round(|k|) = r of a frequency box.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct RingMoments {
+    /// Frequencies in the ring.
+    pub count: usize,
+    /// Their mean.
+    pub mean: f64,
+    /// Σ (value − mean)² over the ring.
+    pub centred_squares: f64,
+}
+
+/// The moments of `values` (one per frequency of `freqs`, box order) on
+/// every ring round(|k|) = r of the box, r = 0 …, from two compensated
+/// passes: means, then centred squares (no E[X²] − E[X]² cancellation).
+/// Shared by the radial profile and the radial variance form.
+pub fn ring_moments(freqs: &FrequencyBox, values: &[f64]) -> Vec<RingMoments> {
     let mut k = vec![0i64; freqs.dim];
-    let mut sum = vec![0.0; h + 1];
-    let mut count = vec![0usize; h + 1];
-    for (idx, &p) in spectrum.power.iter().enumerate() {
-        let r = ring_of(idx, &mut k);
-        if (1..=h).contains(&r) {
-            sum[r] += p;
-            count[r] += 1;
-        }
+    let ring: Vec<usize> = (0..freqs.len())
+        .map(|idx| {
+            freqs.frequency(idx, &mut k);
+            let r2: i64 = k.iter().map(|v| v * v).sum();
+            (r2 as f64).sqrt().round() as usize
+        })
+        .collect();
+    let rings = ring.iter().copied().max().map_or(0, |r| r + 1);
+    let mut count = vec![0usize; rings];
+    let mut sums = vec![NeumaierSum::default(); rings];
+    for (&r, &v) in ring.iter().zip(values) {
+        count[r] += 1;
+        sums[r].add(v);
     }
-    let mean: Vec<f64> = sum
+    let mean: Vec<f64> = sums
         .iter()
         .zip(&count)
-        .map(|(s, &c)| if c > 0 { s / c as f64 } else { 0.0 })
+        .map(|(s, &c)| if c > 0 { s.value() / c as f64 } else { 0.0 })
         .collect();
-    let mut centred = vec![0.0; h + 1];
-    for (idx, &p) in spectrum.power.iter().enumerate() {
-        let r = ring_of(idx, &mut k);
-        if (1..=h).contains(&r) {
-            centred[r] += (p - mean[r]).powi(2);
-        }
+    let mut centred = vec![NeumaierSum::default(); rings];
+    for (&r, &v) in ring.iter().zip(values) {
+        centred[r].add((v - mean[r]).powi(2));
     }
-    (1..=h)
-        .filter(|&r| count[r] > 1)
-        .map(|r| {
-            let var = centred[r] / (count[r] - 1) as f64;
-            let anisotropy = if mean[r] > 0.0 {
-                var / (mean[r] * mean[r])
+    (0..rings)
+        .map(|r| RingMoments {
+            count: count[r],
+            mean: mean[r],
+            centred_squares: centred[r].value(),
+        })
+        .collect()
+}
+
+/// The radial profile of a spectrum for rings 1..=h (only rings that lie
+/// wholly in the box) with at least two frequencies.
+pub fn radial_profile(spectrum: &Spectrum) -> Vec<RadialBin> {
+    let h = spectrum.freqs.half;
+    ring_moments(&spectrum.freqs, &spectrum.power)
+        .into_iter()
+        .enumerate()
+        .filter(|&(r, m)| (1..=h).contains(&r) && m.count > 1)
+        .map(|(r, m)| {
+            let var = m.centred_squares / (m.count - 1) as f64;
+            let anisotropy = if m.mean > 0.0 {
+                var / (m.mean * m.mean)
             } else {
                 0.0
             };
             RadialBin {
                 k: r,
-                power: mean[r],
+                power: m.mean,
                 anisotropy,
-                count: count[r],
+                count: m.count,
             }
         })
         .collect()

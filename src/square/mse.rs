@@ -24,6 +24,15 @@ pub struct SquareMse {
     pub per_set: Vec<f64>,
 }
 
+impl SquareMse {
+    /// The normal 95% interval of the MSE from its standard error over the
+    /// members, clamped at 0.
+    pub fn interval_95(&self) -> (f64, f64) {
+        let half = crate::variance::NORMAL_95 * self.stderr;
+        ((self.mse - half).max(0.0), self.mse + half)
+    }
+}
+
 /// Refuses a family MSE of `sets` sets over `members` members that would
 /// not fit in memory ([`family_mse`] keeps every member's squared error of
 /// every set: 8 bytes each, and 32 per member).
@@ -71,7 +80,7 @@ pub fn family_mse(sets: &[PointSet], family: &Family, members: usize, seed: u64)
         .collect();
     let per_member: Vec<f64> = errors
         .iter()
-        .map(|e| e.iter().sum::<f64>() / e.len().max(1) as f64)
+        .map(|e| crate::sum::sum(e.iter().copied()) / e.len().max(1) as f64)
         .collect();
     let mean = crate::sum::sum(per_member.iter().copied()) / members as f64;
     let spread = if members > 1 {
@@ -80,7 +89,7 @@ pub fn family_mse(sets: &[PointSet], family: &Family, members: usize, seed: u64)
         0.0
     };
     let per_set = (0..sets.len())
-        .map(|s| errors.iter().map(|e| e[s]).sum::<f64>() / members as f64)
+        .map(|s| crate::sum::sum(errors.iter().map(|e| e[s])) / members as f64)
         .collect();
     SquareMse {
         mse: mean,

@@ -51,6 +51,9 @@ fn estimate(f: &dyn Integrand, set: &PointSet, shift: &[f64]) -> f64 {
     acc.value() / set.intensity()
 }
 
+/// The two-sided 95% quantile of the standard normal, Φ⁻¹(0.975).
+pub const NORMAL_95: f64 = 1.959_963_984_540_054;
+
 /// The seed of the shifts when none is given (`predict --method
 /// empirical`, the report's empirical column): one constant, so the report's
 /// numbers are what the command it prints gives.
@@ -147,7 +150,7 @@ where
     let m4 = sum(values.iter().map(|v| (v - mean).powi(4))) / r;
     let variance = m2 / (r - 1.0);
     let var_of_var = ((m4 - variance * variance * (r - 3.0) / (r - 1.0)) / r).max(0.0);
-    let half_width = 1.959_963_984_540_054 * var_of_var.sqrt();
+    let half_width = NORMAL_95 * var_of_var.sqrt();
     Ok(EmpiricalEstimate {
         variance,
         stderr: var_of_var.sqrt(),

@@ -16,7 +16,9 @@ pub mod radial;
 pub mod spatial;
 
 pub use convergence::{SlopeError, SlopeFit, fit_slope, theoretical_rate};
-pub use empirical::{DEFAULT_SHIFT_SEED, EmpiricalEstimate, empirical, empirical_shifting};
+pub use empirical::{
+    DEFAULT_SHIFT_SEED, EmpiricalEstimate, NORMAL_95, empirical, empirical_shifting,
+};
 pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_parts};
 pub use measure::{SamplerVariance, VarianceForm, fourier_half, sampler_variance};
 pub use radial::{RadialEstimate, radial_from};

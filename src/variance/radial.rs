@@ -18,6 +18,7 @@
 //! the wrong rate.
 
 use super::fourier::FourierParts;
+use crate::spectrum::radial::ring_moments;
 use crate::sum::NeumaierSum;
 
 /// The radial prediction.
@@ -37,47 +38,24 @@ pub struct RadialEstimate {
 
 /// The radial form from the Fourier form's spectra.
 pub fn radial_from(parts: &FourierParts) -> RadialEstimate {
-    let spectrum = &parts.spectrum;
-    let freqs = spectrum.freqs;
-    let pf = &parts.integrand_power;
-    let mut k = vec![0i64; freqs.dim];
-    let ring: Vec<usize> = (0..freqs.len())
-        .map(|idx| {
-            freqs.frequency(idx, &mut k);
-            let r2: i64 = k.iter().map(|v| v * v).sum();
-            (r2 as f64).sqrt().round() as usize
-        })
-        .collect();
-    let rings = ring.iter().copied().max().unwrap_or(0) + 1;
-    // Two passes per ring: means, then centred squares.
-    let mut count = vec![0usize; rings];
-    let (mut sum_s, mut sum_f) = (vec![0.0; rings], vec![0.0; rings]);
-    for (idx, &r) in ring.iter().enumerate() {
-        count[r] += 1;
-        sum_s[r] += spectrum.power[idx];
-        sum_f[r] += pf[idx];
-    }
-    let mean = |s: &[f64], r: usize| s[r] / count[r].max(1) as f64;
-    let (mut sq_s, mut sq_f) = (vec![0.0; rings], vec![0.0; rings]);
-    for (idx, &r) in ring.iter().enumerate() {
-        sq_s[r] += (spectrum.power[idx] - mean(&sum_s, r)).powi(2);
-        sq_f[r] += (pf[idx] - mean(&sum_f, r)).powi(2);
-    }
+    let freqs = &parts.spectrum.freqs;
+    let sampling = ring_moments(freqs, &parts.spectrum.power);
+    let integrand = ring_moments(freqs, &parts.integrand_power);
+    let rings = sampling.len();
     let (mut in_box, mut bound) = (NeumaierSum::default(), NeumaierSum::default());
-    for r in 1..rings {
-        if count[r] == 0 {
+    for (s, f) in sampling.iter().zip(&integrand).skip(1) {
+        if s.count == 0 {
             continue;
         }
-        let c = count[r] as f64;
-        in_box.add(c * mean(&sum_s, r) * mean(&sum_f, r));
+        in_box.add(s.count as f64 * s.mean * f.mean);
         // n·σ_S·σ_f with population standard deviations.
-        bound.add((sq_s[r] * sq_f[r]).sqrt());
+        bound.add((s.centred_squares * f.centred_squares).sqrt());
     }
     let nf = parts.intensity;
     RadialEstimate {
         variance: in_box.value() / nf + parts.estimate.tail + parts.estimate.count_term,
         anisotropy_bound: bound.value() / nf,
         truncation_bound: parts.estimate.truncation_bound,
-        rings: rings - 1,
+        rings: rings.saturating_sub(1),
     }
 }
