@@ -134,12 +134,20 @@ pub fn packing_radius(n: usize, dim: usize) -> Option<f64> {
     }
 }
 
-/// The closest pair of `set` (toroidal distance) over the hexagonal
-/// spacing ([`hexagonal_spacing`]).
-pub fn closest_pair_ratio(set: &PointSet) -> f64 {
+/// The relative radii of Lagae & Dutré (2008, §3) of a 2D set: its
+/// minimum and mean nearest-neighbour distance (toroidal) over the
+/// hexagonal spacing ([`hexagonal_spacing`]), [δ_min, δ̄]; 1 is the
+/// densest packing.
+pub fn relative_radii(set: &PointSet) -> [f64; 2] {
     let hex = hexagonal_spacing(set.len());
-    nearest_neighbour_distances(set)
-        .into_iter()
-        .fold(f64::INFINITY, f64::min)
-        / hex
+    let nn = nearest_neighbour_distances(set);
+    let min = nn.iter().copied().fold(f64::INFINITY, f64::min);
+    let mean = crate::sum::sum(nn.iter().copied()) / nn.len().max(1) as f64;
+    [min / hex, mean / hex]
+}
+
+/// The closest pair of `set` (toroidal distance) over the hexagonal
+/// spacing: δ_min of [`relative_radii`].
+pub fn closest_pair_ratio(set: &PointSet) -> f64 {
+    relative_radii(set)[0]
 }

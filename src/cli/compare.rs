@@ -8,8 +8,7 @@ use anyhow::{Context, bail};
 
 use super::progress;
 use varspec::io::write_atomic;
-use varspec::neighbours::hexagonal_spacing;
-use varspec::neighbours::nearest_neighbour_distances;
+use varspec::neighbours::relative_radii;
 use varspec::registry;
 use varspec::report::png::{render_points, save_png};
 use varspec::samplers;
@@ -70,12 +69,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         // Lagae & Dutré (2008) relative radii: distances over the hexagonal
         // packing distance, the minimum (δ_min) and mean (δ̄) nearest-neighbour
         // distance, averaged over sets.
-        let r_max = hexagonal_spacing(n);
         let (mut min_rel, mut mean_rel) = (0.0, 0.0);
         for set in &sets {
-            let nn = nearest_neighbour_distances(set);
-            min_rel += nn.iter().copied().fold(f64::INFINITY, f64::min) / r_max;
-            mean_rel += nn.iter().sum::<f64>() / nn.len() as f64 / r_max;
+            let [min, mean] = relative_radii(set);
+            min_rel += min;
+            mean_rel += mean;
         }
         let k = sets.len() as f64;
         let png = a.output.join(format!("{name}.png"));
