@@ -508,6 +508,9 @@ fn the_pixel_shear_search_picks_the_warp_of_a_defocused_edge_and_sees_double_wed
         })
         .unwrap()
     };
+    let show = |e: &varspec::variance::EmpiricalEstimate| {
+        format!("{:.3e} [{:.3e}, {:.3e}]", e.variance, e.ci_low, e.ci_high)
+    };
     // One depth: the warp following κ, several times below no shear (the
     // render test above measures < 0.25× over whole images).
     let f = PixelIntegrand::new(Arc::new(edge_scene(6.0, 3.0, 0.3, 0.05)), 4, 4);
@@ -522,13 +525,9 @@ fn the_pixel_shear_search_picks_the_warp_of_a_defocused_edge_and_sees_double_wed
     // end below a third of the unsheared one's lower end.
     assert!(
         chosen.ci_high < none.ci_low / 3.0,
-        "warp {:.3e} [{:.3e}, {:.3e}] vs none {:.3e} [{:.3e}, {:.3e}]",
-        chosen.variance,
-        chosen.ci_low,
-        chosen.ci_high,
-        none.variance,
-        none.ci_low,
-        none.ci_high
+        "warp {} vs none {}",
+        show(&chosen),
+        show(&none)
     );
     // An occluder at depth 2 in front of the plane at 6 with its edge
     // across the pixel: two depths, a double wedge; no candidate may end
@@ -552,14 +551,10 @@ fn the_pixel_shear_search_picks_the_warp_of_a_defocused_edge_and_sees_double_wed
     let (none, chosen) = (fresh(&f, SampleShear::NONE), fresh(&f, found.best().shear));
     assert!(
         chosen.ci_low <= none.ci_high,
-        "{:?}: {:.3e} [{:.3e}, {:.3e}] vs none {:.3e} [{:.3e}, {:.3e}]",
+        "{:?}: {} vs none {}",
         found.best().shear,
-        chosen.variance,
-        chosen.ci_low,
-        chosen.ci_high,
-        none.variance,
-        none.ci_low,
-        none.ci_high
+        show(&chosen),
+        show(&none)
     );
 }
 
