@@ -44,6 +44,31 @@ pub fn sum(values: impl IntoIterator<Item = f64>) -> f64 {
     s.value()
 }
 
+/// The mean of `values` by a compensated sum (NaN for none).
+pub fn mean(values: &[f64]) -> f64 {
+    sum(values.iter().copied()) / values.len() as f64
+}
+
+/// The unbiased sample variance of `values` by two compensated passes (the
+/// mean, then centred squares: no E[X²] − E[X]² cancellation); 0 below two
+/// values.
+pub fn sample_variance(values: &[f64]) -> f64 {
+    if values.len() < 2 {
+        return 0.0;
+    }
+    let m = mean(values);
+    sum(values.iter().map(|v| (v - m) * (v - m))) / (values.len() - 1) as f64
+}
+
+/// The mean of `values` and its standard error √(s²/R) (0 below two
+/// values).
+pub fn mean_and_stderr(values: &[f64]) -> (f64, f64) {
+    (
+        mean(values),
+        (sample_variance(values) / values.len() as f64).sqrt(),
+    )
+}
+
 /// Terms of one compensated partial sum in [`par_sum`].
 const TERMS_PER_TASK: usize = 1 << 14;
 

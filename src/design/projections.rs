@@ -121,7 +121,7 @@ pub fn design_projections(
         .collect::<Result<Vec<_>, _>>()?;
     let seconds = start.elapsed().as_secs_f64();
     let points: Vec<PointSet> = results.iter().map(|x| x.1.points.clone()).collect();
-    let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
+    let mean = |v: Vec<f64>| crate::sum::mean(&v);
     let terms_out = terms
         .iter()
         .enumerate()

@@ -21,6 +21,7 @@ use crate::registry;
 use crate::samplers::{Sampler, SamplerError};
 use crate::spectrum::Upsampling;
 use crate::spectrum::nufft::nufft_memory_bytes;
+use crate::sum::mean;
 
 /// What to design (the options of `optimize points` on the torus).
 #[derive(Debug, Clone)]
@@ -122,10 +123,6 @@ pub struct TorusDesign {
     /// Largest rounding bound of the exact variances.
     #[serde(skip)]
     pub rounding: f64,
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
 }
 
 impl TorusPlan {

@@ -140,7 +140,7 @@ pub fn pixel_shears(
                                 stream,
                             )?);
                         }
-                        let v = sample_variance(&values);
+                        let v = crate::sum::sample_variance(&values);
                         if v < best.1 {
                             best = (shear, v);
                         }
@@ -362,10 +362,4 @@ impl PixelStatistics {
             p95: rank(0.95),
         }
     }
-}
-
-fn sample_variance(values: &[f64]) -> f64 {
-    let n = values.len() as f64;
-    let mean = crate::sum::sum(values.iter().copied()) / n;
-    crate::sum::sum(values.iter().map(|v| (v - mean) * (v - mean))) / (n - 1.0)
 }

@@ -270,7 +270,7 @@ where
         .zip(&counts)
         .map(|(v, &c)| v / nf + count_bias(c))
         .collect();
-    let (_, stderr) = super::spatial::mean_and_stderr(&per_set);
+    let (_, stderr) = crate::sum::mean_and_stderr(&per_set);
     Ok(FourierParts {
         estimate: FourierEstimate {
             variance: in_box + tail + count_term,

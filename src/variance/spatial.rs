@@ -176,22 +176,11 @@ where
         per_set.push(v);
         rounding_bound = rounding_bound.max(rounding);
     }
-    let (mean, stderr) = mean_and_stderr(&per_set);
+    let (mean, stderr) = crate::sum::mean_and_stderr(&per_set);
     Ok(SpatialEstimate {
         variance: mean,
         rounding_bound,
         stderr,
         sets,
     })
-}
-
-/// Mean and standard error of the mean, two-pass.
-pub(crate) fn mean_and_stderr(values: &[f64]) -> (f64, f64) {
-    let r = values.len() as f64;
-    let mean = crate::sum::sum(values.iter().copied()) / r;
-    if values.len() < 2 {
-        return (mean, 0.0);
-    }
-    let ss = crate::sum::sum(values.iter().map(|v| (v - mean).powi(2)));
-    (mean, (ss / (r - 1.0) / r).sqrt())
 }

@@ -45,6 +45,7 @@ use crate::samplers::Sampler;
 use crate::spectrum::pair::PairSpectrum;
 use crate::spectrum::{FrequencyBox, Method, expected_power_with};
 use crate::sum::NeumaierSum;
+use crate::sum::{mean, sample_variance};
 
 /// Terms (or realizations) summed per parallel task: fixed, so the sum's
 /// rounding is the same for any number of threads.
@@ -767,18 +768,4 @@ fn draw(sampler: &dyn Sampler, seed: u64, count: usize) -> Result<Vec<PointSet>,
                 .map_err(OptimizeError::from)
         })
         .collect()
-}
-
-/// Mean of `values` (compensated).
-fn mean(values: &[f64]) -> f64 {
-    crate::sum::sum(values.iter().copied()) / values.len() as f64
-}
-
-/// Unbiased sample variance (two passes).
-fn sample_variance(values: &[f64]) -> f64 {
-    if values.len() < 2 {
-        return 0.0;
-    }
-    let m = mean(values);
-    crate::sum::sum(values.iter().map(|v| (v - m) * (v - m))) / (values.len() - 1) as f64
 }
