@@ -4,7 +4,7 @@
 //! is smooth, its gradient.
 
 use crate::polygon::{UNIT_SQUARE, clip, shoelace};
-use crate::quadrature::gauss_legendre;
+use crate::quadrature::integrate_panels;
 
 /// A 2D integrand on [0,1]², evaluated without any shift.
 pub trait SquareIntegrand: Send + Sync {
@@ -73,8 +73,6 @@ impl Gaussian {
     /// ≥ 0.0025 a panel spans at most 2.5 standard deviations, where the
     /// rule is exact to about 1e-15).
     fn square_integral(&self) -> f64 {
-        static RULE: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
-        let (nodes, weights) = RULE.get_or_init(|| gauss_legendre(16));
         let [a11, a12, a22] = self.a;
         let schur = a11 - a12 * a12 / a22;
         let root = (0.5 * a22).sqrt();
@@ -85,16 +83,7 @@ impl Gaussian {
             let (lo, hi) = (-self.mu[1] + b, 1.0 - self.mu[1] + b);
             (-0.5 * schur * dx * dx).exp() * scale * (libm::erf(root * hi) - libm::erf(root * lo))
         };
-        let panels = 8;
-        let width = 1.0 / panels as f64;
-        let mut total = 0.0;
-        for p in 0..panels {
-            let mid = (p as f64 + 0.5) * width;
-            for (z, w) in nodes.iter().zip(weights) {
-                total += 0.5 * width * w * inner(mid + 0.5 * width * z);
-            }
-        }
-        total
+        integrate_panels(0.0, 1.0, 8, inner)
     }
 
     fn quadratic(&self, x: [f64; 2]) -> (f64, [f64; 2]) {
