@@ -11,7 +11,11 @@ use super::progress;
 use varspec::experiment::{
     ExperimentFile, Shard, ShardFile, merge_shards, run_items, write_results,
 };
+use varspec::io::shards::{read_shard_files, shard_file_name};
 use varspec::io::write_atomic;
+
+/// An experiment shard's file name before its `i-of-n.json`.
+const SHARD_PREFIX: &str = "shard-";
 
 #[derive(clap::Args)]
 #[command(after_help = "\
@@ -96,7 +100,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .with_context(|| format!("{file}: cannot create {}", out.display()))?;
     varspec::experiment::remove_other_runs(&out, a.shard)?;
     if a.shard.is_some() {
-        let name = format!("shard-{}-of-{}.json", shard.index, shard.count);
+        let name = shard_file_name(SHARD_PREFIX, shard.index, shard.count);
         let shard_file = ShardFile {
             experiment: e,
             file,
@@ -115,31 +119,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 }
 
 pub fn merge(a: MergeArgs) -> anyhow::Result<()> {
-    let mut shards = Vec::new();
-    let entries = std::fs::read_dir(&a.folder)
-        .with_context(|| format!("cannot read folder {}", a.folder.display()))?;
-    let mut paths: Vec<PathBuf> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with("shard-") && n.ends_with(".json"))
-        })
-        .collect();
-    paths.sort();
-    if paths.is_empty() {
-        bail!(
-            "{}: no shard-i-of-n.json files to merge",
-            a.folder.display()
-        );
-    }
-    for p in &paths {
-        let text = varspec::io::read_text_bounded(p, 1 << 30, "an experiment shard")
-            .with_context(|| format!("cannot read {}", p.display()))?;
-        let shard: ShardFile = varspec::io::from_json(&text)
-            .map_err(|e| anyhow::anyhow!("{}: not a shard file: {e}", p.display()))?;
-        shards.push(shard);
-    }
+    let shards: Vec<ShardFile> =
+        read_shard_files(&a.folder, SHARD_PREFIX, 1 << 30, "an experiment shard")?;
     let (e, file, cells) = merge_shards(&shards)?;
     let out = a.output.unwrap_or(a.folder);
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;

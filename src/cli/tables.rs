@@ -9,6 +9,7 @@ use super::args::DrawArgs;
 use super::progress;
 use varspec::experiment::Shard;
 use varspec::io::read_point_sets;
+use varspec::io::shards::{read_shard_files, shard_file_name};
 use varspec::io::tables::{TableFormat, write_table};
 use varspec::io::write_atomic;
 use varspec::registry;
@@ -153,10 +154,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The shard file of `output` for shard i of n.
+/// The shard file of `output` for shard i of n: `OUTPUT.shard-i-of-n.json`
+/// beside it.
 fn shard_path(output: &std::path::Path, shard: Shard) -> PathBuf {
     let mut name = output.as_os_str().to_owned();
-    name.push(format!(".shard-{}-of-{}.json", shard.index, shard.count));
+    name.push(shard_file_name(".shard-", shard.index, shard.count));
     PathBuf::from(name)
 }
 
@@ -198,29 +200,5 @@ fn read_table_shards(output: &std::path::Path) -> anyhow::Result<Vec<TableShard>
         .file_name()
         .context("--merge needs -o naming the table file")?;
     let prefix = format!("{}.shard-", file.to_string_lossy());
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(folder)
-        .with_context(|| format!("cannot read folder {}", folder.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with(&prefix) && n.ends_with(".json"))
-        })
-        .collect();
-    paths.sort();
-    if paths.is_empty() {
-        bail!(
-            "no {prefix}i-of-n.json files in {} to merge (write them with --shard i/n)",
-            folder.display()
-        );
-    }
-    paths
-        .iter()
-        .map(|p| {
-            let text = varspec::io::read_text_bounded(p, 1 << 34, "a table shard")
-                .with_context(|| format!("cannot read {}", p.display()))?;
-            varspec::io::from_json(&text)
-                .map_err(|e| anyhow::anyhow!("{}: not a table shard: {e}", p.display()))
-        })
-        .collect()
+    Ok(read_shard_files(folder, &prefix, 1 << 34, "a table shard")?)
 }

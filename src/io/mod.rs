@@ -6,6 +6,7 @@ pub mod csv_rows;
 pub mod json;
 pub mod npy;
 pub mod pointfile;
+pub mod shards;
 pub mod tables;
 
 pub use atomic::{
