@@ -654,7 +654,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
         // The pixel's own light-field power on the same planes: where the
         // sets' dark regions should lie.
         for (name, dims, axes) in PLANES {
-            let power = f.plane_power(dims, 128, 16, a.seed)?;
+            let power = f.plane_power(dims, 128, PixelIntegrand::RAYS_PER_CELL, a.seed)?;
             varspec::report::plot::power_png(
                 &power,
                 &format!("{} light field, {name} plane", f.spec()),

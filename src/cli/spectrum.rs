@@ -83,7 +83,7 @@ fn integrand_power(
             .checked_mul(4)
             .filter(|&g| g >= 8)
             .context("--res must be at least 5 for a pixel (and at most 2^60)")?;
-        let power = f.plane_power(dims, grid, PIXEL_RAYS_PER_CELL, seed)?;
+        let power = f.plane_power(dims, grid, PixelIntegrand::RAYS_PER_CELL, seed)?;
         return Ok((power, f.spec()));
     }
     let f = varspec::integrands::parse(spec)?;
@@ -97,10 +97,6 @@ fn integrand_power(
     };
     Ok((varspec::integrands::plane_power(&*f, dims, half)?, f.spec()))
 }
-
-/// Random rays averaged per cell of a pixel's marginal (the scene
-/// module's default for its light-field pictures).
-const PIXEL_RAYS_PER_CELL: usize = 16;
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     if a.res < 3 {

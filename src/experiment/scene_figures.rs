@@ -40,9 +40,6 @@ const SELECTION_STREAM: u64 = 0x5e_1ec7;
 /// nested scramble (25.7 s before the nested scramble drew only its top
 /// ⌈log₂ N⌉ levels), 2 cores.
 pub(super) const REFERENCE_SAMPLER: &str = "sobol:scramble=hash";
-/// Random points per cell of a pixel's light-field power
-/// ([`PixelIntegrand::plane_power`]).
-const LIGHT_FIELD_POINTS_PER_CELL: usize = 16;
 /// The planes of a pixel figure: the seed's XU and YV.
 const PIXEL_PLANES: [&str; 2] = ["xu", "yv"];
 
@@ -383,7 +380,7 @@ pub(super) fn scene_pixels(
         let here = format!("{prefix}-{px}-{py}");
         for p in &planes {
             let (dims, axes) = plane(p)?;
-            let power = f.plane_power(dims, res, LIGHT_FIELD_POINTS_PER_CELL, seed)?;
+            let power = f.plane_power(dims, res, PixelIntegrand::RAYS_PER_CELL, seed)?;
             power_png(
                 &power,
                 &format!(

@@ -163,6 +163,11 @@ impl PixelIntegrand {
         &self.scene
     }
 
+    /// The random points per cell of [`PixelIntegrand::plane_power`] that
+    /// the commands and figures use: 16 (a 128² grid of the `dof` scene's
+    /// pixels draws in a fraction of a second).
+    pub const RAYS_PER_CELL: usize = 16;
+
     /// The pixel's light-field power in the plane of coordinates `dims`
     /// (e.g. [0, 2], XU): |F_g(k)|² of the marginal g = ∫∫ f over the other
     /// two coordinates, which is the 4D power P_f on that plane through the
