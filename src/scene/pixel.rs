@@ -164,8 +164,7 @@ impl PixelIntegrand {
     }
 
     /// The random points per cell of [`PixelIntegrand::plane_power`] that
-    /// the commands and figures use: 16 (a 128² grid of the `dof` scene's
-    /// pixels draws in a fraction of a second).
+    /// every command and figure uses.
     pub const RAYS_PER_CELL: usize = 16;
 
     /// The pixel's light-field power in the plane of coordinates `dims`
