@@ -15,7 +15,6 @@ use varspec::optimize::adapted::{
     CheckpointEvent, CheckpointPlan, checkpoint_path, remove_checkpoints,
 };
 use varspec::registry;
-use varspec::rng::set_rng;
 use varspec::spectrum::Upsampling;
 
 #[derive(Subcommand)]
@@ -608,9 +607,7 @@ fn sheared_outputs(
     sampler: &dyn varspec::samplers::Sampler,
     transform: impl Fn(&varspec::PointSet) -> anyhow::Result<varspec::PointSet>,
 ) -> anyhow::Result<()> {
-    let sets: Vec<_> = (0..a.sets as u64)
-        .map(|r| sampler.sample(&mut set_rng(a.seed, r)))
-        .collect::<Result<_, _>>()?;
+    let sets = varspec::samplers::generate_sets(sampler, a.seed, a.sets, &|| {})?;
     let sheared: Vec<_> = sets.iter().map(transform).collect::<Result<_, _>>()?;
     if let Some(path) = &a.output {
         varspec::io::write_point_file(path, &sheared)?;

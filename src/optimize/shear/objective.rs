@@ -758,8 +758,19 @@ fn sum_over_sets(
     (scalars, total)
 }
 
-/// Realizations 0..count of `sampler` from `seed`.
+/// Realizations 0..count of `sampler` from `seed`, refused before drawing
+/// when they would not fit in memory (up to 4096 realizations of N points:
+/// 268 MB at N = 4096).
 fn draw(sampler: &dyn Sampler, seed: u64, count: usize) -> Result<Vec<PointSet>, OptimizeError> {
+    let bytes = count as f64 * (sampler.points_per_set() * sampler.dim() * 8 + 64) as f64;
+    crate::memory::check(
+        &format!(
+            "the shear objective's {count} realizations of the estimated half ({} points)",
+            sampler.points_per_set()
+        ),
+        Some(bytes),
+        "lower -n",
+    )?;
     (0..count as u64)
         .into_par_iter()
         .map(|r| {
