@@ -693,12 +693,12 @@ fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
             file: file.into(),
             caption: format!("{method}: per-pixel variance over {renders} renders"),
         });
-        let mut sorted = maps.variance.pixels.clone();
-        sorted.sort_by(f64::total_cmp);
+        // The statistics `render --summary` prints for the same map.
+        let stats = crate::scene::render::PixelStatistics::of(&maps.variance.pixels);
         rows.push(SceneRow {
             method: method.into(),
-            mean_variance: crate::sum::sum(sorted.iter().copied()) / sorted.len() as f64,
-            median_variance: sorted[sorted.len() / 2],
+            mean_variance: stats.mean,
+            median_variance: stats.median,
             seconds,
         });
     }
