@@ -1,7 +1,8 @@
 //! Compensated summation (Neumaier 1974, "Rundungsfehleranalyse einiger
 //! Verfahren zur Summation endlicher Summen", ZAMM 54): the error of a long
 //! sum stays O(ε·Σ|x|) independent of its length, which the spatial
-//! predictor's N² terms of both signs need.
+//! predictor's N² terms of both signs need; and the statistics built on
+//! such sums (mean, sample variance, standard error).
 
 /// A running Neumaier sum.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -53,20 +54,22 @@ pub fn mean(values: &[f64]) -> f64 {
 /// mean, then centred squares: no E[X²] − E[X]² cancellation); 0 below two
 /// values.
 pub fn sample_variance(values: &[f64]) -> f64 {
+    variance_about(values, mean(values))
+}
+
+/// Σ(v − m)²/(R − 1), 0 below two values.
+fn variance_about(values: &[f64], m: f64) -> f64 {
     if values.len() < 2 {
         return 0.0;
     }
-    let m = mean(values);
     sum(values.iter().map(|v| (v - m) * (v - m))) / (values.len() - 1) as f64
 }
 
 /// The mean of `values` and its standard error √(s²/R) (0 below two
 /// values).
 pub fn mean_and_stderr(values: &[f64]) -> (f64, f64) {
-    (
-        mean(values),
-        (sample_variance(values) / values.len() as f64).sqrt(),
-    )
+    let m = mean(values);
+    (m, (variance_about(values, m) / values.len() as f64).sqrt())
 }
 
 /// Terms of one compensated partial sum in [`par_sum`].

@@ -26,6 +26,18 @@ fn ok(args: &[&str]) {
     );
 }
 
+/// Runs shard `shard` ("i/n") of the experiment `file` into `out`.
+fn run_shard(file: &std::path::Path, shard: &str, out: &std::path::Path) {
+    ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "--shard",
+        shard,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+}
+
 #[test]
 fn shards_merged_equal_the_single_run_byte_for_byte() {
     let dir = temp_dir("experiment");
@@ -38,14 +50,7 @@ fn shards_merged_equal_the_single_run_byte_for_byte() {
         let sharded = dir.join(format!("sharded-{count}"));
         // Shards in reverse order: the merge must not depend on it.
         for i in (0..count).rev() {
-            ok(&[
-                "experiment",
-                f,
-                "--shard",
-                &format!("{i}/{count}"),
-                "-o",
-                sharded.to_str().unwrap(),
-            ]);
+            run_shard(&file, &format!("{i}/{count}"), &sharded);
         }
         ok(&["merge", sharded.to_str().unwrap()]);
         for name in [
@@ -152,20 +157,12 @@ fn a_rerun_keeps_the_notes_written_by_hand_below_the_marker() {
     assert_eq!(second, format!("{}\n\n{notes}", first.trim_end()));
     // A sharded run keeps them too: a shard run cuts the README down to
     // the notes and the merge puts the tables back above them.
-    let o = out.to_str().unwrap();
     for shard in ["0/2", "1/2"] {
-        ok(&[
-            "experiment",
-            file.to_str().unwrap(),
-            "--shard",
-            shard,
-            "-o",
-            o,
-        ]);
+        run_shard(&file, shard, &out);
         let between = std::fs::read_to_string(out.join("README.md")).unwrap();
         assert_eq!(between, notes, "a shard run left more than the notes");
     }
-    ok(&["merge", o]);
+    ok(&["merge", out.to_str().unwrap()]);
     let merged = std::fs::read_to_string(out.join("README.md")).unwrap();
     assert_eq!(merged, second, "the merge lost the notes");
     std::fs::remove_dir_all(&dir).unwrap();
@@ -941,14 +938,7 @@ fn a_merge_refuses_shards_whose_cells_do_not_match_their_items() {
     std::fs::write(&file, SMALL.replace(", \"cmj\"", "")).unwrap();
     let runs = dir.join("runs");
     for shard in ["0/2", "1/2"] {
-        ok(&[
-            "experiment",
-            file.to_str().unwrap(),
-            "--shard",
-            shard,
-            "-o",
-            runs.to_str().unwrap(),
-        ]);
+        run_shard(&file, shard, &runs);
     }
     let read = |name: &str| -> serde_json::Value {
         serde_json::from_str(&std::fs::read_to_string(runs.join(name)).unwrap()).unwrap()

@@ -9,13 +9,10 @@ use anyhow::{Context, bail};
 
 use super::progress;
 use varspec::experiment::{
-    ExperimentFile, Shard, ShardFile, merge_shards, run_items, write_results,
+    ExperimentFile, SHARD_PREFIX, Shard, ShardFile, merge_shards, run_items, write_results,
 };
 use varspec::io::shards::{read_shard_files, shard_file_name};
 use varspec::io::write_atomic;
-
-/// An experiment shard's file name before its `i-of-n.json`.
-const SHARD_PREFIX: &str = "shard-";
 
 #[derive(clap::Args)]
 #[command(after_help = "\

@@ -19,6 +19,8 @@ mod spec;
 pub use figures::{Figure, FigureExperiment};
 
 pub use file::ExperimentFile;
-pub use report::{KEPT_NOTES, remove_other_runs, remove_variance_runs, write_results};
+pub use report::{
+    KEPT_NOTES, SHARD_PREFIX, remove_other_runs, remove_variance_runs, write_results,
+};
 pub use run::{Cell, RadialCell, Shard, ShardFile, merge_shards, run_items};
 pub use spec::{Experiment, ExperimentError, RadialComparison};

@@ -300,6 +300,10 @@ pub(super) fn with_kept_notes(out: &Path, md: String) -> String {
     }
 }
 
+/// An experiment shard's file name before its `i-of-n.json`
+/// ([`crate::io::shards::shard_file_name`]).
+pub const SHARD_PREFIX: &str = "shard-";
+
 /// Removes what a run of the other kind left in `out`, so a folder never
 /// holds tables and shards of different runs side by side: a whole run
 /// (`shard` None) removes every `shard-*-of-*.json`; a shard run of a
@@ -317,7 +321,7 @@ pub fn remove_other_runs(out: &Path, shard: Option<Shard>) -> Result<(), Experim
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
         let split = name
-            .strip_prefix("shard-")
+            .strip_prefix(SHARD_PREFIX)
             .and_then(|r| r.strip_suffix(".json"))
             .and_then(|r| r.split_once("-of-"))
             .and_then(|(_, n)| n.parse::<usize>().ok());

@@ -230,6 +230,12 @@ pub fn check_size(
     Ok(())
 }
 
+/// Bytes `sets` realizations of `sampler` hold (coordinates and the set's
+/// own fields), the estimate [`generate_sets`] checks before drawing.
+pub fn sets_bytes(sampler: &dyn Sampler, sets: usize) -> f64 {
+    sets as f64 * (sampler.points_per_set() as f64 * sampler.dim() as f64 * 8.0 + 64.0)
+}
+
 /// Draws `sets` realizations of `sampler` in parallel; realization r uses
 /// the stream [`set_rng`]`(seed, r)`. `on_set_done` is called once per
 /// finished set (for progress display).
@@ -244,14 +250,13 @@ pub fn generate_sets(
     sets: usize,
     on_set_done: &(dyn Fn() + Sync),
 ) -> Result<Vec<PointSet>, SamplerError> {
-    let per_set = sampler.points_per_set() as f64 * sampler.dim() as f64 * 8.0 + 64.0;
     crate::memory::check(
         &format!(
             "{sets} realizations of {} points in {}D",
             sampler.points_per_set(),
             sampler.dim()
         ),
-        Some(sets as f64 * per_set),
+        Some(sets_bytes(sampler, sets)),
         "lower --sets",
     )?;
     (0..sets as u64)

@@ -31,19 +31,23 @@ pub struct RingMoments {
     pub centred_squares: f64,
 }
 
-/// The moments of `values` (one per frequency of `freqs`, box order) on
-/// every ring round(|k|) = r of the box, r = 0 …, from two compensated
-/// passes: means, then centred squares (no E[X²] − E[X]² cancellation).
-/// Shared by the radial profile and the radial variance form.
-pub fn ring_moments(freqs: &FrequencyBox, values: &[f64]) -> Vec<RingMoments> {
+/// The ring round(|k|) of every frequency of `freqs`, in box order.
+pub fn rings_of(freqs: &FrequencyBox) -> Vec<usize> {
     let mut k = vec![0i64; freqs.dim];
-    let ring: Vec<usize> = (0..freqs.len())
+    (0..freqs.len())
         .map(|idx| {
             freqs.frequency(idx, &mut k);
             let r2: i64 = k.iter().map(|v| v * v).sum();
             (r2 as f64).sqrt().round() as usize
         })
-        .collect();
+        .collect()
+}
+
+/// The moments of `values` (one per frequency, box order, in the rings
+/// `ring` of [`rings_of`]) on every ring r = 0 …, from two compensated
+/// passes: means, then centred squares (no E[X²] − E[X]² cancellation).
+/// Shared by the radial profile and the radial variance form.
+pub fn ring_moments(ring: &[usize], values: &[f64]) -> Vec<RingMoments> {
     let rings = ring.iter().copied().max().map_or(0, |r| r + 1);
     let mut count = vec![0usize; rings];
     let mut sums = vec![NeumaierSum::default(); rings];
@@ -73,7 +77,7 @@ pub fn ring_moments(freqs: &FrequencyBox, values: &[f64]) -> Vec<RingMoments> {
 /// wholly in the box) with at least two frequencies.
 pub fn radial_profile(spectrum: &Spectrum) -> Vec<RadialBin> {
     let h = spectrum.freqs.half;
-    ring_moments(&spectrum.freqs, &spectrum.power)
+    ring_moments(&rings_of(&spectrum.freqs), &spectrum.power)
         .into_iter()
         .enumerate()
         .filter(|&(r, m)| (1..=h).contains(&r) && m.count > 1)

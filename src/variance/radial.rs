@@ -18,7 +18,7 @@
 //! the wrong rate.
 
 use super::fourier::FourierParts;
-use crate::spectrum::radial::ring_moments;
+use crate::spectrum::radial::{ring_moments, rings_of};
 use crate::sum::NeumaierSum;
 
 /// The radial prediction.
@@ -38,9 +38,9 @@ pub struct RadialEstimate {
 
 /// The radial form from the Fourier form's spectra.
 pub fn radial_from(parts: &FourierParts) -> RadialEstimate {
-    let freqs = &parts.spectrum.freqs;
-    let sampling = ring_moments(freqs, &parts.spectrum.power);
-    let integrand = ring_moments(freqs, &parts.integrand_power);
+    let ring = rings_of(&parts.spectrum.freqs);
+    let sampling = ring_moments(&ring, &parts.spectrum.power);
+    let integrand = ring_moments(&ring, &parts.integrand_power);
     let rings = sampling.len();
     let (mut in_box, mut bound) = (NeumaierSum::default(), NeumaierSum::default());
     for (s, f) in sampling.iter().zip(&integrand).skip(1) {

@@ -41,7 +41,7 @@ use super::layer_sums::{LayerSums, Scratch, SumMethod};
 use crate::integrands::{Integrand, LightField, PlaneWave, light_field_energy};
 use crate::points::PointSet;
 use crate::rng::set_rng;
-use crate::samplers::Sampler;
+use crate::samplers::{Sampler, generate_sets, sets_bytes};
 use crate::spectrum::pair::PairSpectrum;
 use crate::spectrum::{FrequencyBox, Method, expected_power_with};
 use crate::sum::NeumaierSum;
@@ -758,25 +758,18 @@ fn sum_over_sets(
     (scalars, total)
 }
 
-/// Realizations 0..count of `sampler` from `seed`, refused before drawing
-/// when they would not fit in memory (up to 4096 realizations of N points:
-/// 268 MB at N = 4096).
+/// Realizations 0..count of `sampler` from `seed` ([`generate_sets`]),
+/// refused first, naming the objective, when they would not fit in memory
+/// (up to 4096 realizations of N points: 268 MB at N = 4096); the count is
+/// the objective's, not `--sets`, which generate_sets' own refusal names.
 fn draw(sampler: &dyn Sampler, seed: u64, count: usize) -> Result<Vec<PointSet>, OptimizeError> {
-    let bytes = count as f64 * (sampler.points_per_set() * sampler.dim() * 8 + 64) as f64;
     crate::memory::check(
         &format!(
             "the shear objective's {count} realizations of the estimated half ({} points)",
             sampler.points_per_set()
         ),
-        Some(bytes),
+        Some(sets_bytes(sampler, count)),
         "lower -n",
     )?;
-    (0..count as u64)
-        .into_par_iter()
-        .map(|r| {
-            sampler
-                .sample(&mut set_rng(seed, r))
-                .map_err(OptimizeError::from)
-        })
-        .collect()
+    Ok(generate_sets(sampler, seed, count, &|| {})?)
 }
