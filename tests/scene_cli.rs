@@ -104,6 +104,9 @@ fn renders_are_identical_on_one_and_two_threads_and_write_every_output() {
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("one-sum.json")).unwrap()).unwrap();
     assert!(summary["variance"]["mean"].as_f64().unwrap() > 0.0);
+    // Two renders give a variance but no unbiased standard error of its
+    // mean (that needs four: tests/standard_errors.rs).
+    assert!(summary["variance"]["mean_stderr"].is_null(), "{summary}");
     for png in ["img.png", "var.png", "shear.png"] {
         let bytes = std::fs::read(dir.join(format!("one-{png}"))).unwrap();
         assert!(bytes.starts_with(b"\x89PNG"), "{png}");

@@ -14,8 +14,8 @@ use varspec::report::plot::{HeatMap, heatmap_png};
 use varspec::scene::analysis::{PixelKind, SampleShear};
 use varspec::scene::image::GreyImage;
 use varspec::scene::render::{
-    DEFAULT_PILOTS, PixelStatistics, ShearPolicy, analyse, mse_against, pixel_shears, render,
-    render_variance,
+    DEFAULT_PILOTS, PixelStatistics, ShearPolicy, VarianceMaps, analyse, mse_against, pixel_shears,
+    render, render_variance,
 };
 use varspec::scene::{BUILTIN_SCENES, Scene};
 
@@ -178,7 +178,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let analysis = analyse(&scene);
     let shears = pixel_shears(&scene, sampler.as_ref(), policy, &analysis, a.seed)?;
     let bar = progress::bar(a.renders as u64, &format!("render {}", scene.name()));
-    let (image, variance) = if a.renders >= 2 {
+    let (image, maps) = if a.renders >= 2 {
         let maps = render_variance(
             &scene,
             sampler.as_ref(),
@@ -187,7 +187,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.renders,
             &|| bar.inc(1),
         )?;
-        (maps.mean, Some(maps.variance))
+        (maps.mean.clone(), Some(maps))
     } else {
         let img = render(&scene, sampler.as_ref(), &shears, a.seed, 0)?;
         bar.inc(1);
@@ -233,7 +233,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         a.spp,
         a.shear
     );
-    if let Some(var) = &variance {
+    if let Some(var) = maps.as_ref().map(|m| &m.variance) {
         if let Some(path) = &a.variance_pfm {
             var.write_pfm(path)?;
         }
@@ -301,7 +301,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         &a,
         &scene,
         &analysis,
-        variance.as_ref(),
+        maps.as_ref(),
         &image,
         reference.as_ref(),
         seconds,
@@ -313,11 +313,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "{title}: {w}×{h}, {} render(s) in {seconds:.2} s ({:.1} M samples/s){}",
         a.renders,
         (w * h * a.spp * a.renders) as f64 / seconds / 1e6,
-        match &variance {
-            Some(v) => format!(
-                ", mean pixel variance {:.4e}",
-                PixelStatistics::of(&v.pixels).mean
-            ),
+        match &maps {
+            Some(maps) => {
+                let (mean, stderr) = maps.mean_variance();
+                let stderr = stderr.map_or(String::new(), |e| format!(" ± {e:.1e}"));
+                format!(", mean pixel variance {mean:.4e}{stderr}")
+            }
             None => String::new(),
         }
     );
@@ -337,7 +338,7 @@ fn summary_json(
     a: &Args,
     scene: &Scene,
     analysis: &[varspec::scene::analysis::PixelAnalysis],
-    variance: Option<&GreyImage>,
+    maps: Option<&VarianceMaps>,
     image: &GreyImage,
     reference: Option<&GreyImage>,
     seconds: f64,
@@ -359,10 +360,11 @@ fn summary_json(
         },
         "seconds": seconds,
     });
-    if let Some(v) = variance {
-        let stats = PixelStatistics::of(&v.pixels);
+    if let Some(m) = maps {
+        let stats = PixelStatistics::of(&m.variance.pixels);
         out["variance"] = serde_json::json!({
             "mean": stats.mean,
+            "mean_stderr": m.mean_variance().1,
             "median": stats.median,
             "p95": stats.p95,
         });
@@ -370,7 +372,7 @@ fn summary_json(
     if let Some(r) = reference {
         let mse = mse_against(
             &image.pixels,
-            variance.map(|v| v.pixels.as_slice()),
+            maps.map(|m| m.variance.pixels.as_slice()),
             a.renders,
             &r.pixels,
         );

@@ -25,6 +25,7 @@ use crate::scene::render::{
     DEFAULT_PILOTS, PixelStatistics, ShearPolicy, analyse, pixel_shears, reference_image,
     render_variance,
 };
+use crate::sum::ratio_and_stderr;
 
 /// Most samples per pixel a scene figure may ask for.
 pub(super) const MAX_SPP: usize = 1 << 16;
@@ -79,6 +80,18 @@ fn table_error(what: &str, err: String) -> ExperimentError {
     }
 }
 
+/// "a/b× (± its standard error)" for two mean pixel variances with their
+/// standard errors ([`ratio_and_stderr`]; without one below 4 renders).
+fn gain(a: (f64, Option<f64>), b: (f64, Option<f64>)) -> String {
+    match (a.1, b.1) {
+        (Some(sa), Some(sb)) => {
+            let (ratio, stderr) = ratio_and_stderr((a.0, sa), (b.0, sb));
+            format!("{ratio:.2}× (± {stderr:.2})")
+        }
+        _ => format!("{:.2}×", a.0 / b.0),
+    }
+}
+
 /// File of the heat map of lens design `i` (0-based) at the heat-map spp.
 pub(super) fn lens_design_png(prefix: &str, i: usize) -> String {
     format!("{prefix}-variance-lens-design-{}.png", i + 1)
@@ -114,8 +127,8 @@ pub(super) fn scene_variance(
     }
     let mut rows: Vec<Vec<String>> = Vec::new();
     let mut table = String::from(
-        "| spp | sampler | policy | shear | mean variance | median | 95th percentile | MSE vs reference |\n\
-         |---|---|---|---|---|---|---|---|\n",
+        "| spp | sampler | policy | shear | mean variance | ± (standard error) | median | 95th percentile | MSE vs reference |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
     );
     let mut gains = String::new();
     for &requested in spp {
@@ -132,7 +145,7 @@ pub(super) fn scene_variance(
                 2,
                 &|| {},
             )?;
-            let v = PixelStatistics::of(&maps.variance.pixels).mean;
+            let v = maps.mean_variance().0;
             if v < best.1 {
                 best = (c, v);
             }
@@ -145,26 +158,30 @@ pub(super) fn scene_variance(
                        name: &str,
                        policy: ShearPolicy,
                        png: Option<(String, String)>|
-         -> Result<f64, Box<dyn std::error::Error>> {
+         -> Result<(f64, Option<f64>), Box<dyn std::error::Error>> {
             let shears = pixel_shears(&scene, s, policy, &analysis, seed)?;
             let maps = render_variance(&scene, s, &shears, seed, renders, &|| {})?;
             let mse = maps.mse_against(&reference);
             let stats = PixelStatistics::of(&maps.variance.pixels);
+            let (mean, stderr) = maps.mean_variance();
             let shear = match policy {
                 ShearPolicy::Global(c) => format!("{} {}", c.form(), c.amounts()[0]),
                 ShearPolicy::None => "none".into(),
                 _ => "per pixel".into(),
             };
             table += &format!(
-                "| {n} | {who} | {name} | {shear} | {:.3e} | {:.3e} | {:.3e} | {mse:.3e} |\n",
-                stats.mean, stats.median, stats.p95
+                "| {n} | {who} | {name} | {shear} | {mean:.3e} | {} | {:.3e} | {:.3e} | {mse:.3e} |\n",
+                stderr.map_or("—".into(), |e| format!("{e:.1e}")),
+                stats.median,
+                stats.p95
             );
             rows.push(vec![
                 n.to_string(),
                 name.into(),
                 shear,
                 renders.to_string(),
-                format!("{:e}", stats.mean),
+                format!("{mean:e}"),
+                stderr.map_or(String::new(), |e| format!("{e:e}")),
                 format!("{:e}", stats.median),
                 format!("{:e}", stats.p95),
                 format!("{mse:e}"),
@@ -180,7 +197,7 @@ pub(super) fn scene_variance(
                     &out.join(png),
                 )?;
             }
-            Ok(stats.mean)
+            Ok((mean, stderr))
         };
         let mut means = Vec::new();
         for &(name, policy) in &POLICIES {
@@ -195,11 +212,11 @@ pub(super) fn scene_variance(
             means.push(row(s.as_ref(), sampler, name, policy, png)?);
         }
         gains += &format!(
-            "- {n} spp: per-pixel analytic {:.2}× below none, {:.2}× below the best global shear; \
-             pilot {:.2}× below none",
-            means[0] / means[2],
-            means[1] / means[2],
-            means[0] / means[3]
+            "- {n} spp: per-pixel analytic {} below none, {} below the best global shear; \
+             pilot {} below none",
+            gain(means[0], means[2]),
+            gain(means[1], means[2]),
+            gain(means[0], means[3])
         );
         for (i, design) in lens_designs.iter().enumerate() {
             let (d, m) = registry::build_nearest(design, n, Some(4), &[])?;
@@ -214,10 +231,10 @@ pub(super) fn scene_variance(
                 png,
             )?;
             gains += &format!(
-                "; {design} with the per-pixel analytic warp {:.2}× below {sampler}'s none \
-                 ({:.2}× below its own)",
-                means[0] / warped,
-                own / warped
+                "; {design} with the per-pixel analytic warp {} below {sampler}'s none \
+                 ({} below its own)",
+                gain(means[0], warped),
+                gain(own, warped)
             );
         }
         gains += ".\n";
@@ -231,6 +248,7 @@ pub(super) fn scene_variance(
             "shear",
             "renders",
             "mean_variance",
+            "mean_variance_stderr",
             "median_variance",
             "p95_variance",
             "mse_vs_reference",
@@ -248,7 +266,9 @@ pub(super) fn scene_variance(
         "- `{prefix}.csv`, `{prefix}-variance-{{none,per-pixel-analytic,per-pixel-pilot}}.png`{designs} \
          (at {heatmap_spp} spp), `{prefix}-reference.pfm` (hash-scrambled Sobol' {reference_n} spp, 2 renders): \
          scene `{}` with {sampler}, per-pixel variance over {renders} renders, MSE against the \
-         reference.\n\n{table}\n{gains}",
+         reference. The standard errors are of the mean over pixels (each pixel's from its \
+         fourth moment over the renders, from 4 renders on); a gain's treats its two rows as \
+         independent.\n\n{table}\n{gains}",
         scene.name()
     ))
 }
@@ -291,9 +311,13 @@ pub(super) fn scene_samplers(
             let (s, n) = registry::build_nearest(sampler, spp, Some(4), &[])?;
             let maps = render_variance(&scene, s.as_ref(), &none, seed, renders, &|| {})?;
             let mse = maps.mse_against(&reference);
-            let variance = PixelStatistics::of(&maps.variance.pixels).mean;
+            let (variance, stderr) = maps.mean_variance();
             let relative = mse.sqrt() / level;
-            cells[i].push(format!("{variance:.3e} ({:.2}%)", 100.0 * relative));
+            let stderr_text = stderr.map_or(String::new(), |e| format!(" ± {e:.1e}"));
+            cells[i].push(format!(
+                "{variance:.3e}{stderr_text} ({:.2}%)",
+                100.0 * relative
+            ));
             used[i] = format!("{sampler} ({n} spp)");
             rows.push(vec![
                 name.clone(),
@@ -301,6 +325,7 @@ pub(super) fn scene_samplers(
                 n.to_string(),
                 renders.to_string(),
                 format!("{variance:e}"),
+                stderr.map_or(String::new(), |e| format!("{e:e}")),
                 format!("{mse:e}"),
                 format!("{relative:e}"),
             ]);
@@ -315,6 +340,7 @@ pub(super) fn scene_samplers(
             "spp",
             "renders",
             "mean_variance",
+            "mean_variance_stderr",
             "mse_vs_reference",
             "relative_rms_error",
         ],
@@ -334,8 +360,9 @@ pub(super) fn scene_samplers(
         table += &format!("| {name} | {} |\n", row.join(" | "));
     }
     Ok(format!(
-        "- `{file}`: mean per-pixel variance over {renders} renders (relative RMS error against \
-         a hash-scrambled Sobol' {reference_n}-spp reference of 2 renders, in parentheses), no shear.\n\n{table}"
+        "- `{file}`: mean per-pixel variance over {renders} renders ± its standard error \
+         (relative RMS error against a hash-scrambled Sobol' {reference_n}-spp reference of 2 \
+         renders, in parentheses; the standard error needs 4 renders or more), no shear.\n\n{table}"
     ))
 }
 

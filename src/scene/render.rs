@@ -12,7 +12,7 @@ use super::analysis::{MIN_WARP_SLOPE, PixelAnalysis, PixelKind, SampleShear, ana
 use super::image::GreyImage;
 use crate::rng::set_rng;
 use crate::samplers::{Sampler, SamplerError};
-use crate::sum::NeumaierSum;
+use crate::sum::{NeumaierSum, RunningMoments};
 
 /// How each pixel's sample set is sheared.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -226,6 +226,10 @@ pub struct VarianceMaps {
     pub variance: GreyImage,
     /// R.
     pub renders: usize,
+    /// Each pixel's unbiased estimate of Var(s²), the variance of its
+    /// sample variance ([`crate::sum::unbiased_variance_of_sample_variance`];
+    /// None below 4 renders).
+    variance_of_variance: Option<Vec<f64>>,
 }
 
 impl VarianceMaps {
@@ -238,6 +242,21 @@ impl VarianceMaps {
             self.renders,
             &reference.pixels,
         )
+    }
+
+    /// The mean pixel variance and its standard error (None below 4
+    /// renders). Pixels are independent (each has its own random stream),
+    /// so the variance of the mean of P sample variances is Σ Var(s²_p)/P²,
+    /// estimated without bias from each pixel's second and fourth central
+    /// sums over the R renders.
+    pub fn mean_variance(&self) -> (f64, Option<f64>) {
+        let p = self.variance.pixels.len() as f64;
+        let mean = crate::sum::mean(&self.variance.pixels);
+        let stderr = self.variance_of_variance.as_ref().map(|v| {
+            let total = crate::sum::sum(v.iter().copied());
+            total.max(0.0).sqrt() / p
+        });
+        (mean, stderr)
     }
 }
 
@@ -267,8 +286,9 @@ pub fn reference_image(
 }
 
 /// Renders `renders` times (renders 0 … R−1 of `seed`) and accumulates the
-/// per-pixel mean and variance (Welford's update: no difference of large
-/// sums). `progress` is called once per render.
+/// per-pixel mean, variance and fourth moment (Pébay's one-pass update,
+/// [`RunningMoments`]: no difference of large sums). `progress` is called
+/// once per render.
 ///
 /// # Errors
 /// [`RenderError`]; fewer than 2 renders.
@@ -286,36 +306,28 @@ pub fn render_variance(
             min: 2,
         });
     }
-    let mut mean: Option<GreyImage> = None;
-    let mut m2: Vec<f64> = Vec::new();
+    let [width, height] = scene.camera().resolution();
+    let mut moments = vec![RunningMoments::default(); width * height];
     for r in 0..renders {
         let img = render(scene, sampler, shears, seed, r as u64)?;
-        let n = (r + 1) as f64;
-        match &mut mean {
-            None => {
-                m2 = vec![0.0; img.pixels.len()];
-                mean = Some(img);
-            }
-            Some(mean) => {
-                for ((m, s), x) in mean.pixels.iter_mut().zip(&mut m2).zip(&img.pixels) {
-                    let delta = x - *m;
-                    *m += delta / n;
-                    *s += delta * (x - *m);
-                }
-            }
+        for (m, &x) in moments.iter_mut().zip(&img.pixels) {
+            m.add(x);
         }
         progress();
     }
-    let mean = mean.expect("renders ≥ 2");
-    let variance = GreyImage {
-        width: mean.width,
-        height: mean.height,
-        pixels: m2.iter().map(|s| s / (renders - 1) as f64).collect(),
+    let image = |value: fn(&RunningMoments) -> f64| GreyImage {
+        width,
+        height,
+        pixels: moments.iter().map(value).collect(),
     };
     Ok(VarianceMaps {
-        mean,
-        variance,
+        mean: image(RunningMoments::mean),
+        variance: image(RunningMoments::variance),
         renders,
+        variance_of_variance: moments
+            .iter()
+            .map(RunningMoments::variance_of_variance)
+            .collect(),
     })
 }
 

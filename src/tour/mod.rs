@@ -230,6 +230,9 @@ pub struct SceneRow {
     pub method: String,
     /// Mean over pixels of the per-pixel variance.
     pub mean_variance: f64,
+    /// Its standard error ([`crate::scene::render::VarianceMaps::mean_variance`];
+    /// None below 4 renders).
+    pub mean_variance_stderr: Option<f64>,
     /// Median over pixels.
     pub median_variance: f64,
     /// Wall time (analysis, choice and renders).
@@ -698,6 +701,7 @@ fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
         rows.push(SceneRow {
             method: method.into(),
             mean_variance: stats.mean,
+            mean_variance_stderr: maps.mean_variance().1,
             median_variance: stats.median,
             seconds,
         });

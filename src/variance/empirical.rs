@@ -149,7 +149,7 @@ where
     let m2 = sum(values.iter().map(|v| (v - mean).powi(2)));
     let m4 = sum(values.iter().map(|v| (v - mean).powi(4))) / r;
     let variance = m2 / (r - 1.0);
-    let var_of_var = ((m4 - variance * variance * (r - 3.0) / (r - 1.0)) / r).max(0.0);
+    let var_of_var = crate::sum::variance_of_sample_variance(m4, variance, realizations);
     let half_width = NORMAL_95 * var_of_var.sqrt();
     Ok(EmpiricalEstimate {
         variance,
