@@ -103,7 +103,11 @@ impl LightField for Defocus {
 
     fn wave_amplitudes(&self, k: [i64; 2], out: &mut Vec<Complex64>) {
         out.push(
-            self.g.fourier(&k) * crate::spectrum::phase::turn(-0.5 * self.c * (k[0] + k[1]) as f64),
+            self.g.fourier(&k)
+                * crate::spectrum::phase::turn(crate::spectrum::phase::reduced_product(
+                    -0.5 * self.c,
+                    (k[0] + k[1]) as f64,
+                )),
         );
     }
 

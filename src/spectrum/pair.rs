@@ -19,7 +19,7 @@
 use rustfft::num_complex::Complex64;
 
 use crate::points::PointSet;
-use crate::spectrum::phase::{sinc_pi, turn};
+use crate::spectrum::phase::{reduced_product, sinc_pi, turn};
 
 /// One term A·e^(2πi ω·q) of a superposition of plane waves.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,8 +118,8 @@ impl EmpiricalPairs {
         let mut b = Complex64::new(0.0, 0.0);
         let mut diagonal = Complex64::new(0.0, 0.0);
         for q in self.sets[r].points() {
-            let e1 = turn(w1[0] * q[0] + w1[1] * q[1]);
-            let e2 = turn(w2[0] * q[0] + w2[1] * q[1]);
+            let e1 = turn(reduced_product(w1[0], q[0]) + reduced_product(w1[1], q[1]));
+            let e2 = turn(reduced_product(w2[0], q[0]) + reduced_product(w2[1], q[1]));
             a += e1;
             b += e2;
             diagonal += e1 * e2.conj();
@@ -138,7 +138,8 @@ impl EmpiricalPairs {
                 .map(|w| {
                     w.amplitude
                         * turn(
-                            (w.frequency[0] + shift[0]) * q[0] + (w.frequency[1] + shift[1]) * q[1],
+                            reduced_product(w.frequency[0] + shift[0], q[0])
+                                + reduced_product(w.frequency[1] + shift[1], q[1]),
                         )
                 })
                 .sum();

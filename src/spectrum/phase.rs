@@ -13,9 +13,16 @@ use rustfft::num_complex::Complex64;
 /// k·x mod 1, reduced to about [−½, ½], accurate to a few ulps of ½.
 #[inline]
 pub fn reduced_phase(k: i64, x: f64) -> f64 {
-    let kf = k as f64;
-    let p = kf * x;
-    let e = kf.mul_add(x, -p);
+    reduced_product(k as f64, x)
+}
+
+/// w·x mod 1 for any doubles w and x (a real frequency times a
+/// coordinate), reduced to about [−½, ½] by the same exact two-product:
+/// the product's rounding, |w·x|·2⁻⁵³, never enters the phase.
+#[inline]
+pub fn reduced_product(w: f64, x: f64) -> f64 {
+    let p = w * x;
+    let e = w.mul_add(x, -p);
     (p - p.round()) + e
 }
 
@@ -93,5 +100,27 @@ mod tests {
         }
         // The naive product loses digits (documents why the reduction exists).
         assert!(worst_naive > 1e-13, "naive error {worst_naive}");
+    }
+
+    #[test]
+    fn real_frequencies_reduce_exactly() {
+        // w = (2^52 + 1)/2^24 and x = m/2^20 are exact doubles whose product
+        // needs 72 bits; w·x mod 1 is ((2^52 + 1)·m mod 2^44)/2^44 in
+        // integers.
+        let w = ((1u64 << 52) + 1) as f64 / f64::from(1u32 << 24);
+        let mut worst_naive: f64 = 0.0;
+        for m in [1u128, 777_777, 1_048_575, 524_289, 3] {
+            let x = m as f64 / f64::from(1u32 << 20);
+            let r = (((1u128 << 52) + 1) * m) % (1 << 44);
+            let exact = r as f64 / (1u64 << 44) as f64;
+            let exact = exact - exact.round();
+            let ours = reduced_product(w, x);
+            assert!((ours - exact).abs() < 1e-15, "m = {m}: {ours} vs {exact}");
+            let naive = w * x - (w * x).round();
+            worst_naive = worst_naive.max((naive - exact).abs());
+        }
+        // fl(w·x) alone is up to ~10⁸, and its rounding (up to 7e-9) lands
+        // in the phase.
+        assert!(worst_naive > 1e-10, "naive error {worst_naive}");
     }
 }

@@ -35,7 +35,7 @@ use rustfft::num_complex::Complex64;
 use crate::integrands::LightField;
 use crate::points::{PointSet, wrap01};
 use crate::spectrum::nufft::{NufftPlan, NufftScratch, Sign, Upsampling};
-use crate::spectrum::phase::turn;
+use crate::spectrum::phase::{reduced_product, turn};
 use crate::spectrum::{FrequencyBox, SpectrumError};
 
 /// Relative tolerance ε of the box transform: |ΔS(k)| ≤ ε·N (Barnett,
@@ -574,7 +574,7 @@ impl PowerRows {
         self.step_re.clear();
         self.step_im.clear();
         for q in coords.chunks_exact(2) {
-            let z = turn(w * q[axis]);
+            let z = turn(reduced_product(w, q[axis]));
             self.step_re.push(z.re);
             self.step_im.push(z.im);
         }
