@@ -745,8 +745,10 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             })
         })
         .collect();
-    args::check_outputs(
+    let scene_files = varspec::scene::pixel::PixelIntegrand::files_read(&a.integrand);
+    args::check_outputs_beside(
         std::iter::once(a.output.as_deref()).chain(pictures.iter().map(|p| Some(p.as_path()))),
+        scene_files.iter().map(|p| Some(p.as_path())),
     )?;
     if varspec::scene::pixel::PixelIntegrand::is_pixel_spec(&a.integrand) {
         return shear_pixel(a);

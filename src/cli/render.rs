@@ -152,12 +152,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }
         }
     };
+    let scene_files = Scene::files_read(&a.scene);
     args::check_outputs_beside(
         std::iter::once(a.output.as_deref()).chain(a.side_outputs()),
-        [
-            a.reference.as_deref(),
-            Some(std::path::Path::new(&a.scene)).filter(|p| p.is_file()),
-        ],
+        std::iter::once(a.reference.as_deref())
+            .chain(scene_files.iter().map(|p| Some(p.as_path()))),
     )?;
     let scene = Scene::load(&a.scene)?;
     // Every thread holds one pixel's set (and its sheared copy) at a time.

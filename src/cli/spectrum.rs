@@ -105,6 +105,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.res
         );
     }
+    let pixel_files = a
+        .integrand
+        .as_deref()
+        .map_or_else(Vec::new, PixelIntegrand::files_read);
     super::args::check_outputs_beside(
         [
             a.csv.as_deref(),
@@ -113,7 +117,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.png.as_deref(),
             a.radial_png.as_deref(),
         ],
-        [a.source.file()],
+        std::iter::once(a.source.file()).chain(pixel_files.iter().map(|p| Some(p.as_path()))),
     )?;
     let freqs = FrequencyBox::from_resolution(2, a.res);
     let plane = a.source.plane()?;

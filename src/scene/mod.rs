@@ -176,6 +176,32 @@ impl Scene {
         Scene::build(&text, name_or_path, folder, BvhKind::Bvh2)
     }
 
+    /// The files [`Self::load`] reads for `name_or_path`: none for a
+    /// built-in scene; the scene file and the OBJ files of its `obj` shapes
+    /// (relative to its folder) otherwise, or the scene file alone when it
+    /// does not read or parse (loading it will say why). Commands refuse
+    /// outputs that are one of them.
+    pub fn files_read(name_or_path: &str) -> Vec<std::path::PathBuf> {
+        if BUILTIN_SCENES.iter().any(|s| s.0 == name_or_path) {
+            return Vec::new();
+        }
+        let path = std::path::Path::new(name_or_path);
+        let mut files = vec![path.to_path_buf()];
+        let parsed = crate::io::read_text_bounded(path, 64 << 20, "a scene file")
+            .ok()
+            .and_then(|text| SceneFile::parse(&text, name_or_path).ok());
+        if let Some(file) = parsed {
+            let folder = path.parent().unwrap_or(std::path::Path::new(""));
+            files.extend(
+                file.objects
+                    .iter()
+                    .filter_map(|o| o.file.as_ref())
+                    .map(|obj| folder.join(obj)),
+            );
+        }
+        files
+    }
+
     /// A scene from JSON text; `name` names it in errors and reports.
     ///
     /// # Errors

@@ -61,6 +61,12 @@ impl PixelIntegrand {
         spec.starts_with("scene:")
     }
 
+    /// The files a pixel spec reads ([`Scene::files_read`] of its scene;
+    /// none for another spec or a malformed one).
+    pub fn files_read(spec: &str) -> Vec<std::path::PathBuf> {
+        Self::parse_spec(spec).map_or_else(|_| Vec::new(), |(name, _, _)| Scene::files_read(name))
+    }
+
     /// Parses `scene:NAME,px=X,py=Y`, loads the scene and computes the
     /// reference integral.
     ///

@@ -101,7 +101,14 @@ pub fn write_fixtures(dir: &Path) {
             r#"{{"name": "{name}", "samplers": ["jitter"], "integrands": [{integrands}], "n": [{n}], "sets": 2}}"#
         )
     };
-    let files: [(&str, Vec<u8>); 10] = [
+    // A scene whose one object is an OBJ mesh beside it.
+    let scene = r#"{"camera": {"resolution": [8, 8], "fov_degrees": 40, "position": [0, 0, 0],
+        "look_at": [0, 0, -1], "focal_distance": 4, "aperture": 0.06}, "integrand": "lens",
+        "objects": [{"shape": "obj", "file": "m.obj", "translate": [0, 0, -4],
+        "material": {"texture": "checker", "period": 0.5, "low": 0.2, "high": 0.8}}]}"#;
+    let files: [(&str, Vec<u8>); 12] = [
+        ("s.json", scene.into()),
+        ("m.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n".into()),
         ("p.csv", points.into_bytes()),
         ("long-line.csv", vec![b'0'; (1 << 20) + 10]),
         ("bom.csv", "\u{feff}x0,x1\n0.1,0.2\n".into()),
