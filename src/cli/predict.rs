@@ -13,7 +13,7 @@ use varspec::integrands::{self, Integrand};
 use varspec::scene::pixel::PixelIntegrand;
 use varspec::source::SourceError;
 use varspec::variance::{
-    DEFAULT_SHIFT_SEED, VarianceError, empirical, fourier_parts, radial_from, spatial,
+    DEFAULT_SHIFT_SEED, VarianceError, empirical_shifting, fourier_parts, radial_from, spatial,
 };
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -25,6 +25,43 @@ enum MethodArg {
     /// anisotropy bound.
     Radial,
     All,
+}
+
+/// The dimensions the empirical predictor's random shift moves.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum ShiftArg {
+    /// Every dimension: the shift-randomized estimator of the other
+    /// predictors.
+    All,
+    /// Dimensions 0 and 1 only: the estimator a sheared 4D set is judged
+    /// by (a shift in u or v would undo the shear; docs/mathematics.md §6.2).
+    Xy,
+    /// None: the plain estimator of a randomized sampler, or of a file's
+    /// sets taken as independent realizations (each once).
+    None,
+}
+
+impl ShiftArg {
+    /// The shifted dimensions of a d-dimensional integrand.
+    fn dims(self, d: usize) -> Vec<usize> {
+        match self {
+            ShiftArg::All => (0..d).collect(),
+            ShiftArg::Xy => (0..d.min(2)).collect(),
+            ShiftArg::None => Vec::new(),
+        }
+    }
+
+    /// What the estimator is, for the JSON's `estimator`.
+    fn estimator(self) -> &'static str {
+        match self {
+            ShiftArg::All => "shift-randomized: uniform toroidal shift of every dimension",
+            ShiftArg::Xy => {
+                "shifted in (x, y) only: uniform toroidal shift of dimensions 0 and 1 (the \
+                 estimator of sheared 4D sets)"
+            }
+            ShiftArg::None => "unshifted: the mean of f over each realization as it is",
+        }
+    }
 }
 
 #[derive(clap::Args)]
@@ -51,6 +88,12 @@ pub struct Args {
     /// Realizations (fresh sampler randomness and shift each) of the empirical predictor.
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 10_000)]
     realizations: usize,
+    /// Which dimensions the empirical predictor's random shift moves: all
+    /// (the estimator of every predictor), xy (dimensions 0 and 1: how
+    /// sheared 4D sets, e.g. from `optimize shear -o`, are judged) or none
+    /// (a file's sets then count once each).
+    #[arg(long, value_enum, default_value_t = ShiftArg::All, conflicts_with = "family")]
+    shift: ShiftArg,
     /// Fourier box |k| < K/2 (default 256 in 2D, 16 in 4D).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
@@ -105,6 +148,32 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let source = a.source.resolve(Some(f.dim()))?;
     let sets = source.count();
+    if a.shift != ShiftArg::All {
+        if a.method != MethodArg::Empirical {
+            bail!(
+                "--shift {}: only the empirical predictor takes another shift; the Fourier, \
+                 spatial and radial forms are of the estimator shifted in every dimension: add \
+                 --method empirical",
+                a.shift
+                    .to_possible_value()
+                    .map_or("?".into(), |v| v.get_name().to_string())
+            );
+        }
+        if a.shift == ShiftArg::None && a.source.file().is_some() && sets < 2 {
+            bail!(
+                "--shift none: the file holds one set, so one estimate and no variance without a \
+                 shift; give a file of 2 or more sets"
+            );
+        }
+        if a.shift == ShiftArg::None && a.source.file().is_some() && a.realizations > sets {
+            bail!(
+                "--shift none --realizations {}: without a shift the file's {sets} set(s) give \
+                 only {sets} distinct estimates, so repeating them would overstate the \
+                 precision: pass --realizations {sets} or fewer",
+                a.realizations
+            );
+        }
+    }
     let n = source.points_per_set();
     let wants = |m: MethodArg| {
         a.method == m || (a.method == MethodArg::All && (!pixel || m == MethodArg::Empirical))
@@ -133,10 +202,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             )),
         );
     }
-    out.insert(
-        "estimator".into(),
-        json!("shift-randomized: uniform toroidal shift of every dimension"),
-    );
+    out.insert("estimator".into(), json!(a.shift.estimator()));
     if wants(MethodArg::Fourier) || wants(MethodArg::Radial) {
         let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
         let half = res.saturating_sub(1) / 2;
@@ -183,9 +249,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if wants(MethodArg::Empirical) {
         let start = Instant::now();
-        let e = empirical(f.as_ref(), a.realizations, DEFAULT_SHIFT_SEED, |r| {
-            source.get_cyclic(r).map_err(|e| lift(r, e))
-        })?;
+        let shifted = a.shift.dims(f.dim());
+        let e = empirical_shifting(
+            f.as_ref(),
+            a.realizations,
+            DEFAULT_SHIFT_SEED,
+            &shifted,
+            |r| source.get_cyclic(r).map_err(|e| lift(r, e)),
+        )?;
         out.insert(
             "empirical".into(),
             json!({

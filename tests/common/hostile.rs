@@ -106,7 +106,11 @@ pub fn write_fixtures(dir: &Path) {
         "look_at": [0, 0, -1], "focal_distance": 4, "aperture": 0.06}, "integrand": "lens",
         "objects": [{"shape": "obj", "file": "m.obj", "translate": [0, 0, -4],
         "material": {"texture": "checker", "period": 0.5, "low": 0.2, "high": 0.8}}]}"#;
-    let files: [(&str, Vec<u8>); 12] = [
+    let files: [(&str, Vec<u8>); 13] = [
+        (
+            "three.csv",
+            "set,x0,x1\n0,0.1,0.2\n0,0.6,0.7\n1,0.3,0.4\n1,0.8,0.9\n2,0.5,0.1\n2,0.0,0.6\n".into(),
+        ),
         ("s.json", scene.into()),
         ("m.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n".into()),
         ("p.csv", points.into_bytes()),
