@@ -277,6 +277,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         if pixel { "≈" } else { "=" },
         varspec::spec_params::SpecValue(f.integral())
     );
+    if a.shift != ShiftArg::All {
+        outln!("  estimator: {}", a.shift.estimator());
+    }
     for (key, extra) in [
         ("fourier", "truncation_bound"),
         ("spatial", "stderr"),
