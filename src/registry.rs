@@ -130,6 +130,23 @@ pub const SAMPLERS: &[SamplerInfo] = &[
         build: multijitter::cmj_from_config,
     },
     SamplerInfo {
+        name: "lattice",
+        aliases: &["rank1", "korobov"],
+        summary: "randomly shifted integration lattice (Cranley & Patterson 1976): by default the one of N points with the best spectral test, rank-1 or not (Knuth, TAOCP 3.3.4)",
+        dims: DimRange {
+            min: 2,
+            max: 2,
+            default: 2,
+        },
+        count: "any N up to 2^20",
+        params: &[ParamInfo {
+            key: "g",
+            default: "auto",
+            help: "Korobov generator: the rank-1 lattice (i/N, g*i/N mod 1), 1 <= g < N; auto = the best spectral test over every lattice of N points",
+        }],
+        build: crate::optimize::lattice::from_config,
+    },
+    SamplerInfo {
         name: "umj",
         aliases: &[],
         summary: "4D (x,y,u,v): multi-jittered (x,y) and (u,v) sets paired by a random permutation",

@@ -485,9 +485,9 @@ fn compare_writes_a_table_and_pictures() {
         String::from_utf8_lossy(&out.stderr)
     );
     let table = String::from_utf8(out.stdout).unwrap();
-    assert!(table.contains("poisson-disk") && table.contains("sobol"));
+    assert!(table.contains("poisson-disk") && table.contains("sobol") && table.contains("lattice"));
     let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
-    assert_eq!(summary.lines().count(), 11);
+    assert_eq!(summary.lines().count(), 12, "a header and 11 samplers");
     assert!(dir.join("cmj.png").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }

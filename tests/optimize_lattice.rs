@@ -281,3 +281,109 @@ fn lattices_tied_on_the_target_go_to_the_most_two_dimensional() {
     );
     assert!(found.variance <= found.rounding_bound, "{found:?}");
 }
+
+/// The shortest nonzero k with k·(x_i − x_0) ∈ Z for every point of `set`
+/// (its dual lattice's shortest vector, squared length), by brute force
+/// over |k|∞ ≤ `reach`: independent of the sampler's reduction.
+fn shortest_dual_of_points(set: &varspec::PointSet, reach: i64) -> i64 {
+    let p: Vec<&[f64]> = set.points().collect();
+    let mut best = i64::MAX;
+    for k1 in -reach..=reach {
+        for k2 in 0..=reach {
+            let len = k1 * k1 + k2 * k2;
+            if len == 0 || len >= best {
+                continue;
+            }
+            let on_lines = p.iter().all(|q| {
+                let t = k1 as f64 * (q[0] - p[0][0]) + k2 as f64 * (q[1] - p[0][1]);
+                (t - t.round()).abs() < 1e-9
+            });
+            if on_lines {
+                best = len;
+            }
+        }
+    }
+    best
+}
+
+/// The `lattice` sampler: each realization is a group (its differences are
+/// its points, shifted), it passes the spectral test at least as well as
+/// every rank-1 lattice of its N (every generator tried here by brute force
+/// on the dual, {k : k₁ + g·k₂ ≡ 0 mod N}), and `g` gives the Korobov
+/// lattice asked for.
+#[test]
+fn the_lattice_sampler_is_a_shifted_lattice_with_the_best_spectral_test() {
+    for n in [233usize, 256, 100] {
+        let s = registry::build("lattice", n, Some(2), &[]).unwrap();
+        let set = s.sample(&mut set_rng(5, n as u64)).unwrap();
+        assert_eq!(set.len(), n);
+        // A group under addition mod 1: x_i − x_j runs over the same set for
+        // every j.
+        let sorted_differences = |j: usize| {
+            let p: Vec<&[f64]> = set.points().collect();
+            let mut d: Vec<(i64, i64)> = p
+                .iter()
+                .map(|q| {
+                    let w = |t: f64| ((t - t.floor()) * n as f64 * 64.0).round() as i64;
+                    (
+                        w(q[0] - p[j][0]) % (64 * n as i64),
+                        w(q[1] - p[j][1]) % (64 * n as i64),
+                    )
+                })
+                .collect();
+            d.sort_unstable();
+            d
+        };
+        let first = sorted_differences(0);
+        for j in [1, n / 3, n - 1] {
+            assert_eq!(
+                sorted_differences(j),
+                first,
+                "N = {n}: not a lattice at point {j}"
+            );
+        }
+        // Hermite: the dual (determinant N) has a vector of squared length
+        // ≤ 2N/√3, so |k|∞ ≤ √(2N/√3) holds it.
+        let reach = (2.0 * n as f64 / 3f64.sqrt()).sqrt().ceil() as i64;
+        let ours = shortest_dual_of_points(&set, reach);
+        let best_rank1 = (1..n as i64)
+            .map(|g| {
+                let mut best = i64::MAX;
+                for k2 in 0..=reach {
+                    for k1 in -reach..=reach {
+                        let len = k1 * k1 + k2 * k2;
+                        if len > 0 && (k1 + g * k2).rem_euclid(n as i64) == 0 {
+                            best = best.min(len);
+                        }
+                    }
+                }
+                best
+            })
+            .max()
+            .unwrap();
+        assert!(
+            ours >= best_rank1 && ours <= (2.0 * n as f64 / 3f64.sqrt()) as i64,
+            "N = {n}: shortest dual |h|² = {ours}, best rank-1 {best_rank1}"
+        );
+    }
+    // N = 233 = F13 with g = F12 = 144: the Fibonacci lattice, y = 144·x mod 1
+    // up to the shift.
+    let params = [("g".to_string(), "144".to_string())];
+    let s = registry::build("lattice", 233, Some(2), &params).unwrap();
+    let set = s.sample(&mut set_rng(1, 0)).unwrap();
+    let p: Vec<&[f64]> = set.points().collect();
+    for q in &p {
+        let t = 233.0 * ((q[1] - p[0][1]) - 144.0 * (q[0] - p[0][0]));
+        assert!(
+            (t - t.round()).abs() < 1e-6,
+            "{q:?} is off the Fibonacci lattice"
+        );
+    }
+    for bad in ["0", "233", "-3", "1.5"] {
+        let params = [("g".to_string(), bad.to_string())];
+        let Err(err) = registry::build("lattice", 233, Some(2), &params) else {
+            panic!("g = {bad} was accepted")
+        };
+        assert!(err.to_string().contains("1 <= g < N = 233"), "{bad}: {err}");
+    }
+}

@@ -115,7 +115,7 @@ pub fn run(c: BenchCommand) -> anyhow::Result<()> {
 
 /// Samplers timed by `bench samplers`: every 2D and 4D family, both Sobol'
 /// scrambles.
-const TIMED_SAMPLERS: [&str; 10] = [
+const TIMED_SAMPLERS: [&str; 11] = [
     "random",
     "jitter",
     "multijitter",
@@ -123,6 +123,7 @@ const TIMED_SAMPLERS: [&str; 10] = [
     "sobol",
     "sobol:scramble=hash",
     "halton",
+    "lattice",
     "poisson-disk",
     "umj",
     "padded",

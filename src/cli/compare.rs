@@ -14,7 +14,7 @@ use varspec::report::png::{render_points, save_png};
 use varspec::samplers;
 
 /// The 2D samplers compared, in table order.
-const COMPARED: [&str; 10] = [
+const COMPARED: [&str; 11] = [
     "random",
     "regular",
     "jitter",
@@ -25,6 +25,7 @@ const COMPARED: [&str; 10] = [
     "poisson-disk",
     "sobol",
     "halton",
+    "lattice",
 ];
 
 #[derive(clap::Args)]

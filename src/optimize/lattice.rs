@@ -26,6 +26,8 @@ use super::OptimizeError;
 use crate::integrands::Integrand;
 use crate::points::PointSet;
 use crate::rng::{SetRng, uniform};
+use crate::samplers::config::Config;
+use crate::samplers::{Sampler, SamplerError};
 use crate::sum::NeumaierSum;
 
 /// Evaluations of c_f the exhaustive exact ranking may spend (σ(N)·N).
@@ -152,7 +154,7 @@ impl Lattice {
 
 /// The randomly shifted lattice rule as a sampler: each realization is the
 /// lattice moved by a uniform shift drawn from the set's stream.
-impl crate::samplers::Sampler for Lattice {
+impl Sampler for Lattice {
     fn dim(&self) -> usize {
         2
     }
@@ -161,7 +163,7 @@ impl crate::samplers::Sampler for Lattice {
         self.len()
     }
 
-    fn sample(&self, rng: &mut SetRng) -> Result<PointSet, crate::samplers::SamplerError> {
+    fn sample(&self, rng: &mut SetRng) -> Result<PointSet, SamplerError> {
         Ok(self.points([uniform(rng), uniform(rng)]))
     }
 }
@@ -182,6 +184,68 @@ pub struct LatticeDesign {
     pub candidates: usize,
     /// Lattices ranked by the exact form (all, or the screen's finalists).
     pub ranked_exactly: usize,
+}
+
+/// The rank-1 (Korobov) lattice of `n` points with generator `g`:
+/// (i/N, (g·i mod N)/N), i < N, whose dual is {k : k₁ + g·k₂ ≡ 0 mod N}
+/// (Korobov 1959; Sloan & Joe 1994, §2.5).
+pub fn korobov(n: usize, g: usize) -> Lattice {
+    Lattice {
+        a: n,
+        b: (n - g % n) % n,
+        c: 1,
+    }
+}
+
+/// The integration lattice of `n` points that passes the spectral test
+/// best: the longest shortest dual vector ([`Lattice::shortest_dual`]; the
+/// points' parallel lines lie furthest apart), the first in [`lattices`]
+/// order among equals. Every lattice is tried, rank-1 or not: O(σ(N)·log N).
+pub fn best_spectral_lattice(n: usize) -> Lattice {
+    let length = |l: &Lattice| {
+        let h = l.shortest_dual();
+        h[0] * h[0] + h[1] * h[1]
+    };
+    lattices(n)
+        .into_iter()
+        .fold(None, |best: Option<(Lattice, i64)>, l| {
+            let len = length(&l);
+            match best {
+                Some((_, b)) if b >= len => best,
+                _ => Some((l, len)),
+            }
+        })
+        .map(|(l, _)| l)
+        .expect("N >= 1 has the lattice Z²/N")
+}
+
+/// The `lattice` sampler of the registry: [`best_spectral_lattice`], or the
+/// Korobov lattice of the `g` given, under a fresh uniform shift per set
+/// (the randomly shifted lattice rule).
+///
+/// # Errors
+/// [`SamplerError::Count`] above [`MAX_POINTS`]; [`SamplerError::Param`]
+/// for a `g` that is not a whole number in 1 ≤ g < N.
+pub fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
+    if c.n == 0 || c.n > MAX_POINTS {
+        return Err(c.bad_count(
+            "1 <= N <= 2^20: the spectral-test search lists every lattice of N points",
+            (c.n > MAX_POINTS).then_some(MAX_POINTS),
+            (c.n == 0).then_some(1),
+        ));
+    }
+    let lattice = match c.param("g") {
+        "auto" => best_spectral_lattice(c.n),
+        text => match text.parse::<usize>() {
+            Ok(g) if (1..c.n).contains(&g) => korobov(c.n, g),
+            _ => {
+                return Err(
+                    c.bad_param("g", format!("auto or a whole number 1 <= g < N = {}", c.n))
+                );
+            }
+        },
+    };
+    Ok(Box::new(lattice))
 }
 
 /// Every 2D integration lattice of `n` points, in a fixed order.
