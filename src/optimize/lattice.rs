@@ -127,6 +127,13 @@ impl Lattice {
         }
     }
 
+    /// |h|² of [`Self::shortest_dual`]: the spectral test's figure, larger
+    /// is better.
+    pub fn spectral_test(&self) -> i64 {
+        let h = self.shortest_dual();
+        h[0] * h[0] + h[1] * h[1]
+    }
+
     /// Σ P_f(k) over the dual lattice in 0 < |k|∞ ≤ `half` (a lower bound of
     /// the variance, used to screen).
     fn dual_sum(&self, f: &dyn Integrand, half: i64) -> f64 {
@@ -202,20 +209,11 @@ pub fn korobov(n: usize, g: usize) -> Lattice {
 /// points' parallel lines lie furthest apart), the first in [`lattices`]
 /// order among equals. Every lattice is tried, rank-1 or not: O(σ(N)·log N).
 pub fn best_spectral_lattice(n: usize) -> Lattice {
-    let length = |l: &Lattice| {
-        let h = l.shortest_dual();
-        h[0] * h[0] + h[1] * h[1]
-    };
+    // max_by_key keeps the last of equals: reversed, the first in order.
     lattices(n)
         .into_iter()
-        .fold(None, |best: Option<(Lattice, i64)>, l| {
-            let len = length(&l);
-            match best {
-                Some((_, b)) if b >= len => best,
-                _ => Some((l, len)),
-            }
-        })
-        .map(|(l, _)| l)
+        .rev()
+        .max_by_key(Lattice::spectral_test)
         .expect("N >= 1 has the lattice Z²/N")
 }
 
@@ -297,10 +295,7 @@ pub fn best_lattice(n: usize, f: &dyn Integrand) -> Result<LatticeDesign, Optimi
         keep.into_iter().map(|i| all[i]).collect()
     };
     let ranked: Vec<(f64, f64)> = finalists.par_iter().map(|l| l.variance(f)).collect();
-    let spread = |i: usize| {
-        let h = finalists[i].shortest_dual();
-        h[0] * h[0] + h[1] * h[1]
-    };
+    let spread = |i: usize| finalists[i].spectral_test();
     let first_min = |scores: &[(usize, f64)]| {
         scores
             .iter()

@@ -149,6 +149,9 @@ impl Light {
 /// Offsets that keep secondary rays off the surface they leave.
 const RAY_EPSILON: f64 = 1e-4;
 
+/// The largest scene file read (its meshes are OBJ files of their own).
+const MAX_SCENE_BYTES: u64 = 64 << 20;
+
 impl Scene {
     /// A built-in scene by name, or a scene file by path.
     ///
@@ -165,13 +168,12 @@ impl Scene {
                 known: BUILTIN_SCENES.map(|s| s.0).join(", "),
             });
         }
-        let text =
-            crate::io::read_text_bounded(path, 64 << 20, "a scene file").map_err(|cause| {
-                SceneError::Io {
-                    path: name_or_path.into(),
-                    cause,
-                }
-            })?;
+        let text = crate::io::read_text_bounded(path, MAX_SCENE_BYTES, "a scene file").map_err(
+            |cause| SceneError::Io {
+                path: name_or_path.into(),
+                cause,
+            },
+        )?;
         let folder = path.parent().unwrap_or(std::path::Path::new(""));
         Scene::build(&text, name_or_path, folder, BvhKind::Bvh2)
     }
@@ -187,7 +189,7 @@ impl Scene {
         }
         let path = std::path::Path::new(name_or_path);
         let mut files = vec![path.to_path_buf()];
-        let parsed = crate::io::read_text_bounded(path, 64 << 20, "a scene file")
+        let parsed = crate::io::read_text_bounded(path, MAX_SCENE_BYTES, "a scene file")
             .ok()
             .and_then(|text| SceneFile::parse(&text, name_or_path).ok());
         if let Some(file) = parsed {
