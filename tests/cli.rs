@@ -70,6 +70,28 @@ fn output_file_matches_stdout_and_reads_back() {
     let text = String::from_utf8(utk.stdout).unwrap();
     assert_eq!(text.lines().count(), 8);
     assert!(text.lines().all(|l| l.split(' ').count() == 2));
+    // -o /dev/stdout into a pipe (Output captures stdout through one):
+    // /dev/stdout leads to /proc/self/fd/1, whose link text "pipe:[…]" is
+    // no path; the bytes must go through the link.
+    #[cfg(target_os = "linux")]
+    {
+        let piped = varspec(&[
+            "sample",
+            "jitter",
+            "-n",
+            "16",
+            "--sets",
+            "3",
+            "-o",
+            "/dev/stdout",
+        ]);
+        assert!(
+            piped.status.success(),
+            "{}",
+            String::from_utf8_lossy(&piped.stderr)
+        );
+        assert_eq!(piped.stdout, stdout_run.stdout);
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -296,6 +296,16 @@ fn resolve_links(path: &Path) -> io::Result<PathBuf> {
     let mut current = path.to_path_buf();
     for _ in 0..32 {
         match fs::symlink_metadata(&current) {
+            // A link to a device, FIFO or socket is written through the
+            // link: /dev/stdout leads to /proc/self/fd/1, whose target
+            // reads "pipe:[…]", a name no path reaches (only the kernel's
+            // own resolution of the link opens it).
+            Ok(meta)
+                if meta.file_type().is_symlink()
+                    && fs::metadata(&current).is_ok_and(|m| !m.is_file() && !m.is_dir()) =>
+            {
+                return Ok(current);
+            }
             Ok(meta) if meta.file_type().is_symlink() => {
                 let target = fs::read_link(&current)?;
                 current = match current.parent() {
