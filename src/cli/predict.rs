@@ -291,11 +291,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 .as_f64()
                 .map_or("n/a".to_string(), |x| format!("{x:.6e}"));
             let note = match key {
-                "empirical" => format!(
-                    "95% CI [{:.4e}, {:.4e}]",
-                    v["ci_low"].as_f64().unwrap_or(0.0),
-                    v["ci_high"].as_f64().unwrap_or(0.0)
-                ),
+                "empirical" => match v["ci_high"].as_f64() {
+                    Some(high) => format!(
+                        "95% CI [{:.4e}, {high:.4e}]",
+                        v["ci_low"].as_f64().unwrap_or(0.0)
+                    ),
+                    None => "every realization gave the same estimate: no upper bound (raise --realizations)".to_string(),
+                },
                 _ if v.get("skipped").is_some() => {
                     v["skipped"].as_str().unwrap_or_default().to_string()
                 }

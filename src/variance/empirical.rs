@@ -27,7 +27,8 @@ pub struct EmpiricalEstimate {
     pub stderr: f64,
     /// 95% confidence interval, lower end (≥ 0).
     pub ci_low: f64,
-    /// 95% confidence interval, upper end.
+    /// 95% confidence interval, upper end: infinite when every realization
+    /// gave the same estimate (the data then bound nothing above 0).
     pub ci_high: f64,
     /// Mean of Î (estimates I).
     pub mean: f64,
@@ -151,12 +152,52 @@ where
     let variance = m2 / (r - 1.0);
     let var_of_var = crate::sum::variance_of_sample_variance(m4, variance, realizations);
     let half_width = NORMAL_95 * var_of_var.sqrt();
+    // Every realization gave the same estimate (an integrand whose support
+    // no point met, say): the data bound nothing above 0.
+    let ci_high = if m2 > 0.0 {
+        variance + half_width
+    } else {
+        f64::INFINITY
+    };
     Ok(EmpiricalEstimate {
         variance,
         stderr: var_of_var.sqrt(),
         ci_low: (variance - half_width).max(0.0),
-        ci_high: variance + half_width,
+        ci_high,
         mean,
         realizations,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identical_estimates_bound_nothing_above_zero() {
+        // A disk no point of 16 meets in 50 shifted realizations (each hit
+        // has probability 16·π·1e-12): every estimate is 0, the sample
+        // variance 0, and the data give no finite upper end.
+        let tiny = crate::integrands::parse("disk:r=1e-6").unwrap();
+        let grid = PointSet::new(
+            2,
+            (0..16)
+                .flat_map(|i| [f64::from(i % 4) / 4.0, f64::from(i / 4) / 4.0])
+                .collect(),
+        )
+        .unwrap();
+        let e = empirical(tiny.as_ref(), 50, 3, |_| -> Result<_, VarianceError> {
+            Ok(grid.clone())
+        })
+        .unwrap();
+        assert_eq!((e.variance, e.ci_low), (0.0, 0.0));
+        assert!(e.ci_high.is_infinite(), "{e:?}");
+        // A disk every realization meets differently keeps a finite interval.
+        let disk = crate::integrands::parse("disk:r=0.3").unwrap();
+        let e = empirical(disk.as_ref(), 50, 3, |_| -> Result<_, VarianceError> {
+            Ok(grid.clone())
+        })
+        .unwrap();
+        assert!(e.ci_high.is_finite() && e.ci_high > e.variance, "{e:?}");
+    }
 }
