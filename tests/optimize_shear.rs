@@ -201,12 +201,28 @@ fn double_wedges_are_told_from_single_layers() {
         "defocus:shape=gaussian,size=0.9,c=-0.5",
         "defocus:shape=disk,size=0.02,c=0.8",
         "defocus:shape=disk,size=0.6,c=0",
+        // A hairline aperture: its spectrum is flat in k_x, so every
+        // column weighs alike and the slope must be exact to the far ones.
+        "defocus:shape=box,size=0.0001,c=0.7931",
+        // A slope beyond the range the analysis is given.
+        "defocus:shape=disk,size=0.3,c=3.3",
     ] {
         let f = integrands::parse(spec).unwrap();
-        let start = spectral_start(f.as_ref(), 64, 2.0);
-        assert!(!start.double_wedge, "{spec}: {:?}", start.planes[0]);
         let c = f.light_field().unwrap().layer_shears()[0][0];
-        assert!((start.planes[0].lines[0] + c).abs() <= 0.01, "{spec}");
+        // The analysis describes the spectrum whatever the search's range.
+        for range in [2.0, 0.1] {
+            let start = spectral_start(f.as_ref(), 64, range);
+            assert!(
+                !start.double_wedge,
+                "{spec}, range {range}: {:?}",
+                start.planes[0]
+            );
+            assert!(
+                (start.planes[0].lines[0] + c).abs() <= 0.002,
+                "{spec}, range {range}: {:?}",
+                start.planes[0]
+            );
+        }
     }
     for spec in [
         "layers:shape=box,size=0.3,c1=0.5,c2=-0.2",
@@ -435,5 +451,64 @@ fn shearing_steepens_the_convergence_rate() {
     assert!(
         low1024 > 2.0 * high64,
         "gain at N = 1024: {g1024:.2} (lower end {low1024:.2}); at N = 64: {g64:.2} (upper end {high64:.2})"
+    );
+}
+
+#[test]
+fn the_search_widens_its_range_warns_and_handles_degenerate_integrands() {
+    use varspec::optimize::shear::checked::search_and_check;
+    let s = registry::build("umj", 64, Some(4), &[]).unwrap();
+    let run = |spec: &str, range: Option<f64>| {
+        let f = integrands::parse(spec).unwrap();
+        search_and_check(f.as_ref(), s.as_ref(), "umj", 1, range, 0, &|_| {}).unwrap()
+    };
+    // A light field sheared beyond the default range of 2: found without
+    // --range, the range reported; with --range 1 the search stops there
+    // and says why.
+    let wide = run("defocus:shape=disk,size=0.3,c=3.3", None);
+    assert!(
+        wide.found.shear.iter().all(|a| (a + 3.3).abs() <= 0.02),
+        "{:?}",
+        wide.found.shear
+    );
+    assert!(wide.report["range"].as_f64().unwrap() >= 3.3);
+    assert!(wide.warnings.is_empty(), "{:?}", wide.warnings);
+    let cut = run("defocus:shape=disk,size=0.3,c=3.3", Some(1.0));
+    assert!(cut.found.shear.iter().all(|a| a.abs() <= 1.0));
+    assert!(
+        cut.warnings.iter().any(|w| w.contains("outside --range 1")),
+        "{:?}",
+        cut.warnings
+    );
+    // Constant in (x, y): every shear gives 0; no shear, no ratio.
+    let constant = run("defocus:shape=box,size=1,c=0.3", None);
+    assert_eq!(constant.found.shear, [0.0, 0.0]);
+    assert!(constant.report["reduction"].is_null());
+    assert!(constant.warnings.iter().any(|w| w.contains("constant")));
+    // An aperture whose spectrum lies beyond the sum: J cannot tell shears
+    // apart, so the spectrum's direction decides, with a warning.
+    let hairline = run("defocus:shape=box,size=0.0001,c=0.7931", None);
+    assert!(
+        hairline
+            .found
+            .shear
+            .iter()
+            .all(|a| (a + 0.7931).abs() <= 0.002),
+        "{:?}",
+        hairline.found.shear
+    );
+    assert!(
+        hairline
+            .warnings
+            .iter()
+            .any(|w| w.contains("truncation bound")),
+        "{:?}",
+        hairline.warnings
+    );
+    // In focus: the analytic shear is 0, not -0.
+    let focus = run("defocus:shape=disk,size=0.3,c=0", None);
+    assert_eq!(
+        serde_json::to_string(&focus.report["analytic_shear"]).unwrap(),
+        "[[0.0,0.0]]"
     );
 }

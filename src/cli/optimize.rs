@@ -45,9 +45,10 @@ pub struct ShearArgs {
     /// realizations behind an estimated half.
     #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
-    /// Shears searched in [−range, range] on each axis.
-    #[arg(long, default_value_t = 2.0)]
-    range: f64,
+    /// Shears searched in [−range, range] on each axis [default: 2, or
+    /// wider to hold the integrand spectrum's directions].
+    #[arg(long)]
+    range: Option<f64>,
     /// Fresh realizations of the independent before/after check (0: skip it).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 4000)]
     realizations: usize,
@@ -790,7 +791,11 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        let ratio = found.optimum.value / found.unsheared.value;
+        let ratio = if found.optimum.value == found.unsheared.value {
+            1.0
+        } else {
+            found.optimum.value / found.unsheared.value
+        };
         outln!(
             "shear a = {:.4}, b = {:.4} (spectral start {:.4}, {:.4}{}); expected variance {:.4e} -> {:.4e} ({}), search {search_seconds:.2} s",
             found.shear[0],
@@ -824,6 +829,9 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                 after.ci_high
             );
         }
+    }
+    for warning in &run.warnings {
+        eprintln!("warning: {warning}");
     }
     match run.verdict {
         Some(CheckVerdict::Contradicts) => eprintln!(

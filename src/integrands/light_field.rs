@@ -48,7 +48,8 @@ pub trait LightField: Send + Sync {
     fn layer_shears(&self) -> Vec<[f64; 2]> {
         self.wave_slopes()
             .into_iter()
-            .map(|s| [-s[0], -s[1]])
+            // 0 − s, not −s: no −0.0 for a layer in focus.
+            .map(|s| [0.0 - s[0], 0.0 - s[1]])
             .collect()
     }
 }

@@ -567,14 +567,14 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
         .ok_or_else(|| at("the pixel")("not a light field"))?;
     let umj = registry::build("umj", n, Some(4), &[]).map_err(at("umj"))?;
     // The search and its check as `optimize shear` runs them (defaults:
-    // range 2, 4000 check realizations), so the printed command gives
-    // these numbers.
+    // range 2 or wider, 4000 check realizations), so the printed command
+    // gives these numbers.
     let run = crate::optimize::shear::checked::search_and_check(
         f.as_ref(),
         umj.as_ref(),
         "umj",
         o.seed,
-        2.0,
+        None,
         4000,
         &|_| {},
     )

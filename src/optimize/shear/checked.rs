@@ -67,9 +67,20 @@ pub struct CheckedShear {
     pub verdict: Option<CheckVerdict>,
     /// Wall time of the search (without the check), seconds.
     pub search_seconds: f64,
+    /// What the user should know about the result (a range that cuts the
+    /// spectrum's direction, an objective that cannot tell shears apart,
+    /// a constant integrand).
+    pub warnings: Vec<String>,
     /// Everything, as the command's JSON report.
     pub report: Value,
 }
+
+/// The search's half-width when none is given: this, or wider to hold
+/// every spectral candidate with a quarter to spare (rounded up to 0.5).
+pub const DEFAULT_SHEAR_RANGE: f64 = 2.0;
+
+/// Share of J above which its truncation bound gets a warning.
+const LOOSE_TRUNCATION: f64 = 0.5;
 
 /// Refuses what [`search_and_check`] cannot do, before anything is built:
 /// a non-4D integrand, a range outside (0, [`MAX_SHEAR_RANGE`]], one check
@@ -79,7 +90,7 @@ pub struct CheckedShear {
 /// [`OptimizeError::Option`] naming what is wrong.
 pub fn check_request(
     f: &dyn Integrand,
-    range: f64,
+    range: Option<f64>,
     realizations: usize,
 ) -> Result<(), OptimizeError> {
     if f.dim() != 4 {
@@ -94,7 +105,9 @@ pub fn check_request(
             "--realizations 1: the check needs 0 (no check) or at least 2".to_string(),
         ));
     }
-    if !(range.is_finite() && range > 0.0 && range <= MAX_SHEAR_RANGE) {
+    if let Some(range) = range
+        && !(range.is_finite() && range > 0.0 && range <= MAX_SHEAR_RANGE)
+    {
         return Err(OptimizeError::Option(format!(
             "--range {range:?}: the search's half-width must be a positive number up to {MAX_SHEAR_RANGE}"
         )));
@@ -102,9 +115,22 @@ pub fn check_request(
     Ok(())
 }
 
+/// The range searched: `given`, or [`DEFAULT_SHEAR_RANGE`] widened to hold
+/// the `widest` spectral candidate with a quarter to spare.
+fn search_range(given: Option<f64>, widest: f64) -> f64 {
+    given.unwrap_or_else(|| {
+        DEFAULT_SHEAR_RANGE
+            .max((2.5 * widest).ceil() / 2.0)
+            .min(MAX_SHEAR_RANGE)
+    })
+}
+
 /// Searches the shear of `sampler` (named `sampler_name`) for `f` within
-/// [−range, range]² and checks it on `realizations` fresh realizations
-/// (0: no check), telling `progress` what it does next.
+/// [−range, range]² (by default [`DEFAULT_SHEAR_RANGE`], widened to hold the
+/// spectrum's directions) and checks it on `realizations` fresh
+/// realizations (0: no check), telling `progress` what it does next.
+/// An integrand constant in (x, y) gives variance 0 at every shear: it is
+/// not searched and keeps no shear.
 ///
 /// # Errors
 /// [`OptimizeError::Option`] for a non-4D integrand, a bad range or
@@ -114,25 +140,58 @@ pub fn search_and_check(
     sampler: &dyn Sampler,
     sampler_name: &str,
     seed: u64,
-    range: f64,
+    range: Option<f64>,
     realizations: usize,
     progress: &dyn Fn(String),
 ) -> Result<CheckedShear, OptimizeError> {
     check_request(f, range, realizations)?;
     let start = std::time::Instant::now();
     progress("the integrand's spectrum and the frequency terms".into());
-    let spectral = spectral_start(f, 64, range);
+    let spectral = spectral_start(f, 64, range.unwrap_or(DEFAULT_SHEAR_RANGE));
     let mut starts = spectral.candidates();
+    let widest = starts
+        .iter()
+        .flat_map(|c| c.iter().map(|v| v.abs()))
+        .fold(0.0, f64::max);
+    let range = search_range(range, widest);
+    let mut warnings = Vec::new();
+    if widest > range {
+        warnings.push(format!(
+            "the spectrum asks for a shear of up to {widest:.3} on an axis, outside --range {range}: the search stops at the range; widen it (or leave --range out)"
+        ));
+    }
     starts.push([0.0, 0.0]);
     let options = ObjectiveOptions {
         seed,
         ..ObjectiveOptions::default()
     };
     let objective = ShearObjective::new(f, sampler, &starts, options)?;
-    let found = search_shear(&objective, &spectral, range, &|s| {
-        progress(s.to_string());
-    })?;
+    let constant = f.variance() <= 0.0;
+    let found = if constant {
+        warnings.push(
+            "the integrand is constant in (x, y): every shear gives variance 0, so none is applied"
+                .to_string(),
+        );
+        ShearResult::constant()
+    } else {
+        search_shear(&objective, &spectral, range, &|s| {
+            progress(s.to_string());
+        })?
+    };
     let search_seconds = start.elapsed().as_secs_f64();
+    if !constant && objective.truncation_bound() > LOOSE_TRUNCATION * found.optimum.value.abs() {
+        warnings.push(format!(
+            "the objective's truncation bound is {:.2} of J ({} frequency terms of |k|∞ ≤ {}): the integrand's energy lies mostly beyond the sum, J may not tell shears apart{}",
+            objective.truncation_bound() / found.optimum.value.abs(),
+            objective.terms(),
+            objective.half(),
+            if found.shear == found.initial.0 && found.shear != [0.0, 0.0] {
+                ", and the shear is the spectrum's direction"
+            } else {
+                ""
+            }
+        ));
+    }
     let eval_seed = seed ^ 0x0e7a_1000;
     let estimate = |shear: [f64; 2]| -> Result<EmpiricalEstimate, OptimizeError> {
         let sheared = Sheared::new(sampler, shear)?;
@@ -147,7 +206,13 @@ pub fn search_and_check(
         )?)
     };
     let check = if realizations >= 2 {
-        progress(format!("checking on {realizations} fresh realizations"));
+        let timer = std::time::Instant::now();
+        sampler.sample(&mut set_rng(eval_seed ^ 1, 0))?;
+        let per_set = timer.elapsed().as_secs_f64();
+        progress(format!(
+            "checking on {realizations} fresh realizations (about {:.0} s of sampling at {per_set:.2e} s a set; --realizations sets the count)",
+            2.0 * realizations as f64 * per_set / rayon::current_num_threads() as f64
+        ));
         Some((estimate([0.0, 0.0])?, estimate(found.shear)?))
     } else {
         None
@@ -172,8 +237,8 @@ pub fn search_and_check(
         "objective": {
             "description": "expected variance of the estimator over the sampler's randomness (closed form where the halves have one)",
             "unsheared": found.unsheared.value, "initial": found.initial.1, "optimum": found.optimum.value,
-            "stderr": found.optimum.stderr / found.optimum.value,
-            "truncation_bound": objective.truncation_bound() / found.optimum.value,
+            "stderr": (found.optimum.value > 0.0).then(|| found.optimum.stderr / found.optimum.value),
+            "truncation_bound": (found.optimum.value > 0.0).then(|| objective.truncation_bound() / found.optimum.value),
             "evaluations": found.evaluations, "coarse_evaluations": found.coarse_evaluations,
             "terms": objective.terms(), "coarse_terms": objective.coarse_terms(), "half": objective.half(),
             "realizations": objective.realizations(),
@@ -183,7 +248,8 @@ pub fn search_and_check(
         "variance_before": check.as_ref().map(|c| ci(&c.0)),
         "variance_after": check.as_ref().map(|c| ci(&c.1)),
         "check_verdict": verdict.map(CheckVerdict::name),
-        "reduction": found.unsheared.value / found.optimum.value,
+        "reduction": (found.optimum.value > 0.0).then(|| found.unsheared.value / found.optimum.value),
+        "range": range, "warnings": warnings,
         "seconds": search_seconds,
     });
     Ok(CheckedShear {
@@ -192,6 +258,7 @@ pub fn search_and_check(
         check,
         verdict,
         search_seconds,
+        warnings,
         report,
     })
 }

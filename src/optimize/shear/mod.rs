@@ -11,8 +11,10 @@
 //! ranks its deepest local minima), 0.01 around the best on J (a hairline
 //! spectrum has a basin narrower than a coarse grid step), and Brent's
 //! method in the last interval; polish (a, b)
-//! jointly with Nelder–Mead (both from argmin). The result is never worse
-//! than no shear: if J(found) ≥ J(0, 0), the search returns (0, 0).
+//! jointly with Nelder–Mead (both from argmin). Where J cannot tell the
+//! spectral start from the result (within two standard errors), the start
+//! is returned. The result is never worse than no shear: if
+//! J(found) > J(0, 0), the search returns (0, 0).
 
 pub mod checked;
 pub mod layer_sums;
@@ -62,6 +64,28 @@ pub struct ShearResult {
     pub evaluations: u64,
     /// Evaluations of the coarse objective (the scans that locate basins).
     pub coarse_evaluations: u64,
+}
+
+impl ShearResult {
+    /// The result for an integrand constant in (x, y): no shear, variance
+    /// 0 everywhere, nothing evaluated.
+    #[must_use]
+    pub fn constant() -> Self {
+        let zero = Evaluation {
+            value: 0.0,
+            stderr: 0.0,
+        };
+        ShearResult {
+            shear: [0.0, 0.0],
+            optimum: zero,
+            unsheared: zero,
+            initial: ([0.0, 0.0], 0.0),
+            sensitivity: [0.0; 4],
+            kept_unsheared: true,
+            evaluations: 0,
+            coarse_evaluations: 0,
+        }
+    }
 }
 
 /// What the search is doing, for a progress display.
@@ -214,7 +238,19 @@ pub fn search_shear(
         }
     }
     let mut optimum = objective.evaluate(shear)?;
-    let kept_unsheared = optimum.value >= unsheared.value;
+    // Where J cannot tell the spectral start from what the scans found (a
+    // flat objective: a tiny aperture, or an estimated half's noise), the
+    // spectrum's direction decides: two standard errors of the difference,
+    // taken as if the two estimates were independent (they share their
+    // realizations, so the difference is less noisy than that).
+    if shear != initial {
+        let at_start = objective.evaluate(initial)?;
+        if at_start.value <= optimum.value + 2.0 * optimum.stderr.hypot(at_start.stderr) {
+            shear = initial;
+            optimum = at_start;
+        }
+    }
+    let kept_unsheared = optimum.value > unsheared.value;
     if kept_unsheared {
         shear = [0.0, 0.0];
         optimum = unsheared;

@@ -17,13 +17,21 @@
 //!   Σ_(k_x≠0) Σ_(k_u) |E(k) − E_col(k_x)·sinc²(π(k_u − s·k_x))| / Σ E,
 //!   is near 0 for one layer (only the box edge truncates the profile) and
 //!   large when the energy splits between two directions: the seed's
-//!   double wedge, where no single shear fits both layers. Above
+//!   double wedge, where no single shear fits both layers. Where the line
+//!   leaves the box the model keeps the profile's share inside it, and the
+//!   best slope is refined by Brent's method between scan points (a flat
+//!   spectrum, a hairline aperture's, weighs every column alike, and a
+//!   slope off by a scan step's 0.002 misses the far columns' peaks). Above
 //!   [`DOUBLE_WEDGE_MISFIT`] the spectrum is called a double wedge, and the
 //!   slope capturing most energy outside the first line's band
 //!   (|k_u − s·k_x| < 1) is the second layer.
 
 use nalgebra::{Matrix2, SymmetricEigen};
 
+use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
+use argmin::solver::brent::BrentOpt;
+
+use super::MAX_SHEAR_RANGE;
 use crate::integrands::Integrand;
 
 /// Share of a plane's energy (largest frequencies first) in the moment
@@ -35,8 +43,12 @@ const CORE: f64 = 0.9;
 const DOUBLE_WEDGE_MISFIT: f64 = 0.1;
 /// Slopes closer than this are one direction.
 const MIN_SEPARATION: f64 = 0.15;
-/// Slope resolution of the line scan.
+/// Slope resolution of the line scan (finer slopes come from Brent's
+/// method between scan points).
 const SLOPE_STEP: f64 = 0.005;
+/// Most scan points on each side of slope 0: beyond
+/// [`SLOPE_STEP`]·[`MAX_SCAN`] the scan's step widens.
+const MAX_SCAN: f64 = 400.0;
 
 /// The spectrum's directions in one plane, (k_x, k_u) or (k_y, k_v).
 #[derive(Debug, Clone, PartialEq)]
@@ -82,8 +94,10 @@ impl SpectralStart {
 }
 
 /// Reads the directions of a 4D integrand's spectrum on the slices
-/// k_y = k_v = 0 and k_x = k_u = 0 of the box |k|∞ ≤ `half`, slopes
-/// limited to [−`range`, `range`].
+/// k_y = k_v = 0 and k_x = k_u = 0 of the box |k|∞ ≤ `half`: slopes in
+/// [−`range`, `range`], widened to hold the principal direction (up to
+/// [`MAX_SHEAR_RANGE`]), so that the analysis describes the spectrum
+/// whatever range the search is given.
 pub fn spectral_start(f: &dyn Integrand, half: i64, range: f64) -> SpectralStart {
     let plane = |axis: usize| {
         let side = (2 * half + 1) as usize;
@@ -142,11 +156,12 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
         (1, 0)
     };
     let v = eigen.eigenvectors.column(big);
-    let principal = if v[0].abs() * range >= v[1].abs() {
+    let principal = if v[0].abs() * MAX_SHEAR_RANGE >= v[1].abs() {
         v[1] / v[0]
     } else {
-        range.copysign(v[1] * v[0])
+        MAX_SHEAR_RANGE.copysign(v[1] * v[0])
     };
+    let limit = range.max(1.25 * principal.abs() + 0.1).min(MAX_SHEAR_RANGE);
     let eigenvalue_ratio = if eigen.eigenvalues[big] > 0.0 {
         (eigen.eigenvalues[small] / eigen.eigenvalues[big]).max(0.0)
     } else {
@@ -163,8 +178,9 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
         })
         .collect();
     let off_total: f64 = columns.iter().map(|c| c.2).sum();
-    let steps = (range / SLOPE_STEP).round() as i64;
-    let slopes: Vec<f64> = (-steps..=steps).map(|i| i as f64 * SLOPE_STEP).collect();
+    let step = SLOPE_STEP.max(limit / MAX_SCAN);
+    let steps = (limit / step).round() as i64;
+    let slopes: Vec<f64> = (-steps..=steps).map(|i| i as f64 * step).collect();
     if off_total <= 0.0 {
         return PlaneDirections {
             principal,
@@ -178,9 +194,10 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
     let misfit = |s: f64| -> f64 {
         let mut total = 0.0;
         for &(k1, column, sum) in &columns {
-            for (j, &e) in column.iter().enumerate() {
-                let k2 = j as f64 - half as f64;
-                let model = sum * sinc2(k2 - s * k1);
+            let profile: Vec<f64> = (-half..=half).map(|k2| sinc2(k2 as f64 - s * k1)).collect();
+            let inside: f64 = profile.iter().sum();
+            for (&e, &p) in column.iter().zip(&profile) {
+                let model = if inside > 0.0 { sum * p / inside } else { 0.0 };
                 total += (e - model).abs();
             }
         }
@@ -199,14 +216,14 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
         }
         captured / off_total
     };
-    let (s1, one_line_misfit) =
-        slopes
-            .iter()
-            .map(|&s| (s, misfit(s)))
-            .fold(
-                (0.0, f64::INFINITY),
-                |acc, c| if c.1 < acc.1 { c } else { acc },
-            );
+    let scanned = slopes
+        .iter()
+        .map(|&s| (s, misfit(s)))
+        .fold(
+            (0.0, f64::INFINITY),
+            |acc, c| if c.1 < acc.1 { c } else { acc },
+        );
+    let (s1, one_line_misfit) = refine_slope(&misfit, scanned, step, limit);
     let first_line_share = share(s1, None);
     let (s2, second_line_share) = slopes
         .iter()
@@ -224,6 +241,40 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
         first_line_share,
         second_line_share,
         one_line_misfit,
+    }
+}
+
+/// The misfit as an argmin cost of the slope.
+struct Misfit<'m>(&'m dyn Fn(f64) -> f64);
+
+impl CostFunction for Misfit<'_> {
+    type Param = f64;
+    type Output = f64;
+
+    fn cost(&self, s: &f64) -> Result<f64, ArgminError> {
+        Ok((self.0)(*s))
+    }
+}
+
+/// The slope of least `misfit` within one scan `step` of the scan's best
+/// `(slope, misfit)`, by Brent's method (the scan's best if Brent's method
+/// finds nothing lower).
+fn refine_slope(
+    misfit: &dyn Fn(f64) -> f64,
+    (s, value): (f64, f64),
+    step: f64,
+    limit: f64,
+) -> (f64, f64) {
+    let (lo, hi) = ((s - step).max(-limit), (s + step).min(limit));
+    let brent = BrentOpt::new(lo, hi).set_tolerance(1e-6, 1e-9);
+    let refined = Executor::new(Misfit(misfit), brent)
+        .configure(|state| state.max_iters(40))
+        .run()
+        .ok()
+        .and_then(|r| r.state().get_best_param().copied());
+    match refined.map(|t| (t, misfit(t))) {
+        Some((t, v)) if v < value => (t, v),
+        _ => (s, value),
     }
 }
 
