@@ -301,6 +301,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 _ if v.get("skipped").is_some() => {
                     v["skipped"].as_str().unwrap_or_default().to_string()
                 }
+                // The Fourier form has both: its sampling error over the
+                // sets and the bound on its truncation.
+                "fourier" => match (v["stderr"].as_f64(), v[extra].as_f64()) {
+                    (Some(e), Some(x)) => format!("stderr {e:.2e}  {extra} {x:.2e}"),
+                    (None, Some(x)) => format!("{extra} {x:.2e}"),
+                    _ => String::new(),
+                },
                 _ => match v[extra].as_f64() {
                     Some(x) => format!("{extra} {x:.2e}"),
                     None => format!(

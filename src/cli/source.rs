@@ -152,6 +152,13 @@ impl SourceArgs {
                     source.name()
                 );
             }
+            if found < dim {
+                bail!(
+                    "{}: points are {found}-dimensional where {dim} dimensions are needed: a projection \
+                     cannot add dimensions; give points of {dim} or more dimensions, or an integrand of {found}",
+                    source.name()
+                );
+            }
             bail!(
                 "{}: points are {found}-dimensional where {dim} dimensions are needed; choose a projection with --dims \
                  (0,2 is XU, 1,3 is YV)",

@@ -233,8 +233,6 @@ pub struct SceneRow {
     /// Its standard error ([`crate::scene::render::VarianceMaps::mean_variance`];
     /// None below 4 renders).
     pub mean_variance_stderr: Option<f64>,
-    /// Median over pixels.
-    pub median_variance: f64,
     /// Wall time (analysis, choice and renders).
     pub seconds: f64,
 }
@@ -696,13 +694,11 @@ fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
             file: file.into(),
             caption: format!("{method}: per-pixel variance over {renders} renders"),
         });
-        // The statistics `render --summary` prints for the same map.
-        let stats = crate::scene::render::PixelStatistics::of(&maps.variance.pixels);
+        let (mean_variance, mean_variance_stderr) = maps.mean_variance();
         rows.push(SceneRow {
             method: method.into(),
-            mean_variance: stats.mean,
-            mean_variance_stderr: maps.mean_variance().1,
-            median_variance: stats.median,
+            mean_variance,
+            mean_variance_stderr,
             seconds,
         });
     }
