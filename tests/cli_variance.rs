@@ -418,6 +418,81 @@ fn optimize_commands_write_sets_and_reports() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// An integrand target's report gives the classic samplers' exact
+/// variances beside their in-box losses: never below the loss (the
+/// beyond-box terms are ≥ 0), and jitter's agrees with `predict`'s spatial
+/// form on 400 other realizations (z = 3.89 over both standard errors).
+#[test]
+fn an_adapted_report_gives_the_classic_samplers_exact_variances() {
+    let dir = common::temp_dir("adapted-exact");
+    let (out, report) = (dir.join("a.csv"), dir.join("a.json"));
+    let spec = "halfplane:angle=17,offset=0.07";
+    let run = varspec(&[
+        "optimize",
+        "points",
+        "-n",
+        "64",
+        "--target",
+        spec,
+        "--sets",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(text.contains("exact variance"), "{text}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
+        let entry = &r["comparison"][name];
+        let (loss, exact) = (
+            entry["loss"].as_f64().unwrap(),
+            entry["exact_variance"].as_f64().unwrap(),
+        );
+        assert!(
+            exact >= loss,
+            "{name}: exact {exact:e} below its in-box loss {loss:e}"
+        );
+    }
+    let reported = r["comparison"]["jitter"]["exact_variance"]
+        .as_f64()
+        .unwrap();
+    let p = json(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "64",
+        "--integrand",
+        spec,
+        "--method",
+        "spatial",
+        "--sets",
+        "400",
+        "--seed",
+        "11",
+        "--json",
+    ]);
+    let (mean, se400) = (
+        p["spatial"]["variance"].as_f64().unwrap(),
+        p["spatial"]["stderr"].as_f64().unwrap(),
+    );
+    // The report averages 8 sets: their standard error is √(400/8) of 400's.
+    let se = (se400 * se400 * (1.0 + 50.0)).sqrt();
+    assert!(
+        (reported - mean).abs() <= 3.89 * se,
+        "jitter's exact variance {reported:e} against predict's {mean:e} ± {se:e} (z = 3.89)"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn converge_on_a_square_family_matches_predict_and_the_jitter_rate() {
     // Each point of the square convergence is predict --family's brute

@@ -387,8 +387,16 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         );
     }
     for (name, v) in &design.comparison {
+        let exact = match (name.as_str(), v["exact_variance"].as_f64()) {
+            ("optimized", _) => design
+                .exact_variance
+                .map(|e| format!("  exact variance {e:.4e}"))
+                .unwrap_or_default(),
+            (_, Some(e)) => format!("  exact variance {e:.4e}"),
+            _ => String::new(),
+        };
         outln!(
-            "  {name:<14} loss {:.4e}",
+            "  {name:<14} loss {:.4e}{exact}",
             v["loss"].as_f64().unwrap_or(f64::NAN)
         );
     }
