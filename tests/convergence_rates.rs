@@ -92,4 +92,9 @@ fn theory_table_entries() {
     assert_eq!(theoretical_rate("nrooks", band, 2), Some(-2.0));
     assert_eq!(theoretical_rate("lhs", disk, 2), Some(-1.0));
     assert_eq!(theoretical_rate("sobol", disk, 2), None);
+    // CMJ: jitter's rates where discontinuities dominate, none on smooth
+    // integrands (its strata are correlated; it measures −3 on a Gaussian).
+    assert_eq!(theoretical_rate("cmj", disk, 2), Some(-1.5));
+    assert_eq!(theoretical_rate("cmj", band, 2), Some(-2.0));
+    assert_eq!(theoretical_rate("cmj", gauss, 2), None);
 }
