@@ -47,7 +47,9 @@ fn renders_are_identical_on_one_and_two_threads_and_write_every_output() {
         );
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{stderr}");
-        // The closing line names every file written, not only the PNG.
+        // The closing line (on standard output, as every command's summary)
+        // names every file written, not only the PNG.
+        let stdout = String::from_utf8_lossy(&out.stdout);
         for name in [
             "img.png",
             "img.pfm",
@@ -59,7 +61,7 @@ fn renders_are_identical_on_one_and_two_threads_and_write_every_output() {
             "shear.png",
             "sum.json",
         ] {
-            assert!(stderr.contains(&p(name)), "{name} not reported: {stderr}");
+            assert!(stdout.contains(&p(name)), "{name} not reported: {stdout}");
         }
         (
             std::fs::read(p("img.pfm")).unwrap(),

@@ -308,7 +308,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(path) = &a.summary {
         write_atomic(path, |out| writeln!(out, "{summary:#}"))?;
     }
-    eprintln!(
+    outln!(
         "{title}: {w}×{h}, {} render(s) in {seconds:.2} s ({:.1} M samples/s){}",
         a.renders,
         (w * h * a.spp * a.renders) as f64 / seconds / 1e6,
@@ -322,14 +322,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     );
     if let Some(mse) = summary["mse_against_reference"].as_f64() {
-        eprintln!("MSE against the reference {mse:.4e}");
+        outln!("MSE against the reference {mse:.4e}");
     }
     let written: Vec<String> = std::iter::once(Some(output.as_path()))
         .chain(a.side_outputs())
         .flatten()
         .map(|p| p.display().to_string())
         .collect();
-    eprintln!("wrote {}", written.join(", "));
+    outln!("wrote {}", written.join(", "));
     Ok(())
 }
 
