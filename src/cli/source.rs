@@ -26,7 +26,8 @@ pub struct SourceArgs {
     /// Points per realization (with --sampler).
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: Option<usize>,
-    /// Sampler dimension (with --sampler; default: the sampler's own).
+    /// Sampler dimension (with --sampler; default: the dimension the
+    /// analysis needs where the sampler has it, else the sampler's own).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'd', long = "dim")]
     dim: Option<usize>,
     #[command(flatten)]
@@ -115,7 +116,19 @@ impl SourceArgs {
                 }
                 self.draw.check_results_memory()?;
                 let n = self.n.context("--sampler needs -n")?;
-                let sampler = registry::build(name, n, self.dim, &self.draw.params)?;
+                // Without -d or --dims, draw in the dimension the analysis
+                // needs where the sampler has it (as `converge` does): jitter
+                // for a 4D integrand is 4D jitter. A sampler without it
+                // keeps its own, and the check below says what to do.
+                let wanted = self.dim.or(dim.filter(|_| dims.is_none()));
+                let sampler = match registry::build(name, n, wanted, &self.draw.params) {
+                    Err(varspec::samplers::SamplerError::Dimension { .. })
+                        if self.dim.is_none() =>
+                    {
+                        registry::build(name, n, None, &self.draw.params)?
+                    }
+                    built => built?,
+                };
                 Source::Sampler {
                     sampler,
                     seed: self.draw.seed(),
