@@ -231,6 +231,74 @@ fn converge_json_reports_slope_and_interval() {
     assert!(v["adjusted_n"][0].as_str().unwrap().contains("60 -> 64"));
 }
 
+/// `converge --points`: files written by `sample` give exactly the
+/// variances of the sampler they came from (same seed, same sets), and
+/// the fit names no theory; a file per N is required.
+#[test]
+fn converge_on_point_files_matches_the_sampler_they_came_from() {
+    let dir = common::temp_dir("converge-points");
+    let files: Vec<String> = [64, 256, 1024]
+        .iter()
+        .map(|n| {
+            let path = dir.join(format!("j{n}.csv"));
+            let out = varspec(&[
+                "sample",
+                "jitter",
+                "-n",
+                &n.to_string(),
+                "--sets",
+                "8",
+                "--seed",
+                "5",
+                "-o",
+                path.to_str().unwrap(),
+            ]);
+            assert!(out.status.success());
+            path.to_str().unwrap().to_string()
+        })
+        .collect();
+    let from_files = json(&[
+        "converge",
+        "--points",
+        &files.join(","),
+        "--integrand",
+        "disk:r=0.3",
+        "--json",
+    ]);
+    let from_sampler = json(&[
+        "converge",
+        "--sampler",
+        "jitter",
+        "--n",
+        "64,256,1024",
+        "--sets",
+        "8",
+        "--seed",
+        "5",
+        "--integrand",
+        "disk:r=0.3",
+        "--json",
+    ]);
+    assert_eq!(from_files["points"], from_sampler["points"]);
+    assert_eq!(from_files["slope"], from_sampler["slope"]);
+    assert!(from_files["theory"].is_null() && from_sampler["theory"].as_f64() == Some(-1.5));
+    assert_eq!(from_files["sets"], serde_json::json!([8, 8, 8]));
+    assert_eq!(from_files["files"].as_array().unwrap().len(), 3);
+    let twice = varspec(&[
+        "converge",
+        "--points",
+        &format!("{},{}", files[0], files[0]),
+        "--integrand",
+        "disk",
+    ]);
+    assert!(
+        String::from_utf8_lossy(&twice.stderr).contains("give one file per N"),
+        "{}",
+        String::from_utf8_lossy(&twice.stderr)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn bad_requests_fail_clearly() {
     for (args, phrase) in [

@@ -31,8 +31,13 @@ enum MethodArg {
 #[derive(clap::Args)]
 pub struct Args {
     /// Sampler name.
-    #[arg(long)]
-    sampler: String,
+    #[arg(long, required_unless_present = "points", conflicts_with = "points")]
+    sampler: Option<String>,
+    /// Instead of a sampler: point-set files, one per N (e.g. designs
+    /// optimized at each N), comma-separated; every set of a file is a
+    /// realization.
+    #[arg(long, value_delimiter = ',', conflicts_with_all = ["ns", "sets_given", "params"])]
+    points: Vec<PathBuf>,
     /// Integrand spec (the torus, shift-randomized estimator).
     #[arg(long, required_unless_present = "family", conflicts_with = "family")]
     integrand: Option<String>,
@@ -46,7 +51,7 @@ pub struct Args {
     #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
     members: Option<usize>,
     /// Comma-separated N values (constrained samplers use the nearest valid N).
-    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_hyphen_values = true, value_delimiter = ',', required = true)]
+    #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_hyphen_values = true, value_delimiter = ',', required_unless_present = "points")]
     ns: Vec<usize>,
     #[command(flatten)]
     draw: DrawArgs,
@@ -70,10 +75,20 @@ pub struct Args {
 struct Point {
     requested: usize,
     n: usize,
+    /// Realizations behind the variance.
+    sets: usize,
     variance: f64,
     /// `None` from a single set: unknown, not 0.
     stderr: Option<f64>,
     truncation_bound: f64,
+}
+
+/// Where the sets of one N come from.
+enum Level {
+    /// A sampler at the nearest valid N to this one.
+    Sampler(usize),
+    /// Every set of a file.
+    File(PathBuf),
 }
 
 /// What the variance is of: an integrand on the torus, or a family on the
@@ -81,6 +96,36 @@ struct Point {
 enum Subject {
     Torus(Box<dyn integrands::Integrand>),
     Square(Family),
+}
+
+/// The sets of one level: a sampler's realizations, or a file's sets.
+enum SetSource {
+    Sampler(Box<dyn samplers::Sampler>),
+    File(Vec<varspec::PointSet>),
+}
+
+impl SetSource {
+    fn n(&self) -> usize {
+        match self {
+            SetSource::Sampler(s) => s.points_per_set(),
+            SetSource::File(sets) => sets[0].len(),
+        }
+    }
+
+    /// Realizations: `--sets` of a sampler, every set of a file.
+    fn count(&self, sets: usize) -> usize {
+        match self {
+            SetSource::Sampler(_) => sets,
+            SetSource::File(f) => f.len(),
+        }
+    }
+
+    fn set(&self, r: usize, seed: u64) -> Result<varspec::PointSet, VarianceError> {
+        match self {
+            SetSource::Sampler(s) => Ok(s.sample(&mut set_rng(seed, r as u64))?),
+            SetSource::File(sets) => Ok(sets[r].clone()),
+        }
+    }
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -106,9 +151,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Subject::Torus(f) => (f.dim(), f.spec()),
         Subject::Square(family) => (2, family.spec()),
     };
-    if a.ns.len() < 2 {
-        bail!("--n needs at least two values to fit a slope");
+    let levels: Vec<Level> = if a.points.is_empty() {
+        a.ns.iter().map(|&n| Level::Sampler(n)).collect()
+    } else {
+        a.points.iter().cloned().map(Level::File).collect()
+    };
+    if levels.len() < 2 {
+        bail!(
+            "{} needs at least two values to fit a slope",
+            if a.points.is_empty() {
+                "--n"
+            } else {
+                "--points"
+            }
+        );
     }
+    // The label of the sets: the sampler, or "point files".
+    let label = a.sampler.clone().unwrap_or_else(|| "point files".into());
     if a.res.is_some_and(|r| r < 3) {
         bail!("--res must be at least 3 (the box |k| < K/2 must hold a frequency besides 0)");
     }
@@ -117,12 +176,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         MethodArg::Fourier
     });
-    let bar = progress::bar(a.ns.len() as u64, "converge");
+    let bar = progress::bar(levels.len() as u64, "converge");
     let mut points = Vec::new();
-    for &requested in &a.ns {
-        let (sampler, n) =
-            registry::build_nearest(&a.sampler, requested, Some(dim), &a.draw.params).map_err(
-                |e| match e {
+    for level in &levels {
+        let (source, requested) = match level {
+            Level::Sampler(requested) => {
+                let sampler_name = a.sampler.as_deref().unwrap_or_default();
+                let (sampler, _) = registry::build_nearest(
+                    sampler_name,
+                    *requested,
+                    Some(dim),
+                    &a.draw.params,
+                )
+                .map_err(|e| match e {
                     varspec::samplers::SamplerError::Dimension { max, .. } if max < dim => {
                         anyhow::anyhow!(
                             "{e}: {name} is {dim}-dimensional; use a sampler with {dim}D sets \
@@ -130,19 +196,30 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         )
                     }
                     e => e.into(),
-                },
-            )?;
-        let realization = |r: usize| -> Result<_, VarianceError> {
-            Ok(sampler.sample(&mut set_rng(a.draw.seed(), r as u64))?)
+                })?;
+                (SetSource::Sampler(sampler), *requested)
+            }
+            Level::File(path) => {
+                let sets = varspec::io::read_point_sets_of_dim(path, dim)?;
+                if let Some(other) = sets.iter().find(|s| s.len() != sets[0].len()) {
+                    bail!(
+                        "{}: its sets hold {} and {} points; a level of the fit needs one N",
+                        path.display(),
+                        sets[0].len(),
+                        other.len()
+                    );
+                }
+                let n = sets[0].len();
+                (SetSource::File(sets), n)
+            }
         };
+        let (n, count) = (source.n(), source.count(a.draw.sets()));
+        let realization = |r: usize| -> Result<_, VarianceError> { source.set(r, a.draw.seed()) };
         let (variance, stderr, truncation_bound) = match (&subject, method) {
             (Subject::Square(family), _) => {
-                let sets = samplers::generate_sets(
-                    sampler.as_ref(),
-                    a.draw.seed(),
-                    a.draw.sets(),
-                    &|| {},
-                )?;
+                let sets = (0..count)
+                    .map(&realization)
+                    .collect::<Result<Vec<_>, _>>()?;
                 let e = family_mse(&sets, family, members, a.draw.seed());
                 (e.mse, e.stderr, 0.0)
             }
@@ -155,7 +232,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         }),
                     },
                 };
-                let e = sampler_variance(f.as_ref(), a.draw.sets(), form, realization)?;
+                let e = sampler_variance(f.as_ref(), count, form, realization)?;
                 (e.variance, e.stderr, e.truncation_bound)
             }
         };
@@ -165,17 +242,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             );
         }
         if let Some(p) = points.iter().find(|p: &&Point| p.n == n) {
-            bail!(
-                "--n {} and {requested} both become N = {n} for {} (constrained N); give N values that stay distinct",
-                p.requested,
-                a.sampler
-            );
+            if a.points.is_empty() {
+                bail!(
+                    "--n {} and {requested} both become N = {n} for {label} (constrained N); give N values that stay distinct",
+                    p.requested
+                );
+            }
+            bail!("two of --points hold sets of N = {n}; give one file per N");
         }
         points.push(Point {
             requested,
             n,
+            sets: count,
             variance,
-            stderr: (a.draw.sets() >= 2).then_some(stderr),
+            stderr: (count >= 2).then_some(stderr),
             truncation_bound,
         });
         bar.inc(1);
@@ -184,9 +264,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let ns: Vec<f64> = points.iter().map(|p| p.n as f64).collect();
     let vars: Vec<f64> = points.iter().map(|p| p.variance).collect();
     let fit = fit_slope(&ns, &vars)?;
-    let theory = match &subject {
-        Subject::Torus(f) => theoretical_rate(&a.sampler, f.class(), dim),
-        Subject::Square(_) => None,
+    let theory = match (&subject, &a.sampler) {
+        (Subject::Torus(f), Some(sampler)) => theoretical_rate(sampler, f.class(), dim),
+        _ => None,
     };
     let adjusted: Vec<String> = points
         .iter()
@@ -222,7 +302,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             ]
         };
         let mut series = vec![Series {
-            label: format!("{} (slope {:.3})", a.sampler, fit.slope),
+            label: format!("{label} (slope {:.3})", fit.slope),
             points: ns.iter().copied().zip(vars.iter().copied()).collect(),
             reference: false,
         }];
@@ -234,7 +314,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             });
         }
         let plot = LinePlot {
-            title: format!("{} on {name}", a.sampler),
+            title: format!("{label} on {name}"),
             x_label: "N".into(),
             y_label: "variance".into(),
             log_log: true,
@@ -243,14 +323,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         line_plot_png(&plot, path)?;
     }
     if a.json {
+        // One count for a sampler's --sets; per level for files.
+        let points_sets = if a.points.is_empty() {
+            json!(a.draw.sets())
+        } else {
+            json!(points.iter().map(|p| p.sets).collect::<Vec<_>>())
+        };
         let out = json!({
-            "sampler": a.sampler, "integrand": name,
+            "sampler": a.sampler, "files": a.points.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(), "integrand": name,
             "method": match (&subject, method) {
                 (Subject::Square(_), _) => "square: unshifted estimator's MSE over the family (brute force)",
                 (_, MethodArg::Spatial) => "spatial",
                 (_, MethodArg::Fourier) => "fourier",
             },
-            "sets": a.draw.sets(),
+            "sets": points_sets,
             "points": points.iter().map(|p| json!({"n": p.n, "requested": p.requested, "variance": p.variance, "stderr": p.stderr, "truncation_bound": p.truncation_bound})).collect::<Vec<_>>(),
             "slope": fit.slope, "slope_ci": fit.slope_ci.map(|(l, h)| vec![l, h]),
             "theory": theory, "adjusted_n": adjusted,
@@ -259,7 +345,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         return Ok(());
     }
     if !adjusted.is_empty() {
-        outln!("N adjusted to fit {}: {}", a.sampler, adjusted.join(", "));
+        outln!("N adjusted to fit {label}: {}", adjusted.join(", "));
     }
     outln!("{:>8} {:>14} {:>12}", "N", "variance", "stderr");
     for p in &points {

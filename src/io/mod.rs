@@ -16,7 +16,9 @@ pub use atomic::{
 pub use bounded::{read_bounded, read_text_bounded};
 pub use csv_rows::write_csv_rows;
 pub use json::from_json;
-pub use pointfile::{PointFileError, PointFormat, read_point_sets, write_point_sets};
+pub use pointfile::{
+    PointFileError, PointFormat, read_point_sets, read_point_sets_of_dim, write_point_sets,
+};
 
 /// Writes point sets to `path` atomically, as NumPy `.npy` when its
 /// extension says so (any case), else as CSV: the rule of every command's
