@@ -5,13 +5,7 @@ use crate::common;
 use common::{varspec, varspec_with};
 
 fn json(args: &[&str]) -> serde_json::Value {
-    let out = varspec(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("one JSON object")
+    serde_json::from_slice(&common::varspec_ok(args).stdout).expect("one JSON object")
 }
 
 #[test]
@@ -241,20 +235,12 @@ fn converge_on_point_files_matches_the_sampler_they_came_from() {
         .iter()
         .map(|n| {
             let path = dir.join(format!("j{n}.csv"));
-            let out = varspec(&[
-                "sample",
-                "jitter",
-                "-n",
-                &n.to_string(),
-                "--sets",
-                "8",
-                "--seed",
-                "5",
-                "-o",
-                path.to_str().unwrap(),
+            let path = path.to_str().unwrap().to_string();
+            let n = n.to_string();
+            common::varspec_ok(&[
+                "sample", "jitter", "-n", &n, "--sets", "8", "--seed", "5", "-o", &path,
             ]);
-            assert!(out.status.success());
-            path.to_str().unwrap().to_string()
+            path
         })
         .collect();
     let from_files = json(&[
@@ -401,7 +387,7 @@ fn optimize_commands_write_sets_and_reports() {
     let dir = std::env::temp_dir().join(format!("varspec-cliopt-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (out, report) = (dir.join("bn.csv"), dir.join("bn.json"));
-    let run = varspec(&[
+    common::varspec_ok(&[
         "optimize",
         "points",
         "-n",
@@ -417,15 +403,9 @@ fn optimize_commands_write_sets_and_reports() {
         "--report",
         report.to_str().unwrap(),
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     let sets = varspec::io::read_point_sets(&out).unwrap();
     assert_eq!((sets.len(), sets[0].len()), (2, 64));
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::read_json(&report);
     assert!(r["loss_curve"].as_array().unwrap().len() > 10 && r["seconds"].as_f64().unwrap() > 0.0);
     for name in ["optimized", "jitter", "cmj", "sobol", "poisson-disk"] {
         assert!(
@@ -495,7 +475,7 @@ fn an_adapted_report_gives_the_classic_samplers_exact_variances() {
     let dir = common::temp_dir("adapted-exact");
     let (out, report) = (dir.join("a.csv"), dir.join("a.json"));
     let spec = "halfplane:angle=17,offset=0.07";
-    let run = varspec(&[
+    let run = common::varspec_ok(&[
         "optimize",
         "points",
         "-n",
@@ -509,15 +489,9 @@ fn an_adapted_report_gives_the_classic_samplers_exact_variances() {
         "--report",
         report.to_str().unwrap(),
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     let text = String::from_utf8_lossy(&run.stdout);
     assert!(text.contains("exact variance"), "{text}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let r = common::read_json(&report);
     for name in ["jitter", "cmj", "sobol", "poisson-disk"] {
         let entry = &r["comparison"][name];
         let (loss, exact) = (

@@ -10,6 +10,24 @@ pub fn varspec(args: &[&str]) -> Output {
     varspec_with(args, None)
 }
 
+/// Runs `varspec` with `args`, which must succeed (the assertion shows
+/// its standard error), and returns its output.
+pub fn varspec_ok(args: &[&str]) -> Output {
+    let out = varspec(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The JSON object in the file at `path` (a command's report).
+pub fn read_json(path: &std::path::Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).expect("the report exists");
+    serde_json::from_str(&text).expect("one JSON object")
+}
+
 /// Runs `varspec` with `RAYON_NUM_THREADS` set when `threads` is given.
 pub fn varspec_with(args: &[&str], threads: Option<&str>) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_varspec"));
