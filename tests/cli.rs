@@ -86,6 +86,47 @@ fn output_file_matches_stdout_and_reads_back() {
             "/dev/stdout",
         ]);
         assert_eq!(piped.stdout, stdout_run.stdout);
+        // Standard output appending to a file (`>> log`): the bytes go
+        // through the descriptor, after what the file held, not over it.
+        let log = dir.join("log.txt");
+        std::fs::write(&log, "kept\n").unwrap();
+        let appending = std::fs::OpenOptions::new().append(true).open(&log).unwrap();
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_varspec"))
+            .args([
+                "sample",
+                "jitter",
+                "-n",
+                "16",
+                "--sets",
+                "3",
+                "-o",
+                "/dev/stdout",
+            ])
+            .stdout(appending)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let mut expected = b"kept\n".to_vec();
+        expected.extend_from_slice(&stdout_run.stdout);
+        assert_eq!(std::fs::read(&log).unwrap(), expected);
+        // A command's own lines go to standard error while standard output
+        // carries a file: a PNG through a pipe stays a PNG.
+        let png = common::varspec_ok(&[
+            "spectrum",
+            "--sampler",
+            "jitter",
+            "-n",
+            "64",
+            "--res",
+            "32",
+            "--png",
+            "/dev/stdout",
+        ]);
+        assert!(
+            png.stdout.starts_with(b"\x89PNG\r\n\x1a\n"),
+            "{:?}",
+            &png.stdout[..16.min(png.stdout.len())]
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

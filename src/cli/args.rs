@@ -144,6 +144,9 @@ pub fn check_outputs_beside<'a>(
     let mut seen: Vec<(&std::path::Path, std::path::PathBuf)> = Vec::new();
     for path in outputs.into_iter().flatten() {
         varspec::io::check_output(path)?;
+        if varspec::io::is_standard_output(path) {
+            super::stdout::carries_data();
+        }
         let Some(id) = varspec::io::file_identity(path) else {
             continue;
         };

@@ -8,6 +8,7 @@
 use std::fmt;
 use std::io::{self, Write};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// What has happened to standard output so far.
 enum State {
@@ -21,8 +22,23 @@ enum State {
 
 static STATE: Mutex<State> = Mutex::new(State::Open);
 
-/// Writes `args` and a newline to standard output (see the module docs).
+/// Set when an output file is standard output (`-o /dev/stdout`): the
+/// command's lines then go to standard error, so the file's bytes reach
+/// the reader alone.
+static CARRIES_DATA: AtomicBool = AtomicBool::new(false);
+
+/// Standard output carries an output file: lines go to standard error.
+pub fn carries_data() {
+    CARRIES_DATA.store(true, Ordering::Relaxed);
+}
+
+/// Writes `args` and a newline to standard output, or to standard error
+/// when standard output carries a file (see the module docs).
 pub fn line(args: fmt::Arguments) {
+    if CARRIES_DATA.load(Ordering::Relaxed) {
+        let _ = writeln!(io::stderr().lock(), "{args}");
+        return;
+    }
     write(|out| out.write_fmt(args).and_then(|()| out.write_all(b"\n")));
 }
 

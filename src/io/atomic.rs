@@ -177,6 +177,22 @@ where
         path: path.to_path_buf(),
         cause,
     };
+    // This process's standard output, whatever it is (a pipe, a terminal, a
+    // file the shell opened for >>): written through the descriptor, never
+    // replaced by a rename or reopened at offset 0.
+    if is_standard_output(path) {
+        if staging() {
+            let mut bytes = Vec::new();
+            write(&mut bytes).map_err(fail)?;
+            stage(Staged::InPlace {
+                path: path.to_path_buf(),
+                target: path.to_path_buf(),
+                bytes,
+            });
+            return Ok(());
+        }
+        return write_in_place(path, write).map_err(fail);
+    }
     let target = resolve_links(path).map_err(fail)?;
     match fs::metadata(&target) {
         Ok(meta) if meta.is_dir() => {
@@ -335,11 +351,33 @@ fn probe_in_place(target: &Path, meta: &fs::Metadata) -> io::Result<()> {
     fs::OpenOptions::new().write(true).open(target).map(drop)
 }
 
-/// Writes a device, FIFO or socket directly.
+/// Whether `path` is this process's standard output: the same file as
+/// descriptor 1 (`/dev/stdout`, or the file or pipe it leads to). Linux,
+/// through /proc; elsewhere false.
+pub fn is_standard_output(path: &Path) -> bool {
+    #[cfg(target_os = "linux")]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (fs::metadata(path), fs::metadata("/proc/self/fd/1")) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = path;
+    false
+}
+
+/// Writes a device, FIFO or socket directly; standard output through the
+/// process's own descriptor.
 fn write_in_place<F>(path: &Path, write: F) -> io::Result<()>
 where
     F: FnOnce(&mut dyn Write) -> io::Result<()>,
 {
+    if is_standard_output(path) {
+        let mut out = io::stdout().lock();
+        write(&mut out)?;
+        return out.flush();
+    }
     let file = fs::OpenOptions::new().write(true).open(path)?;
     let mut out = BufWriter::new(file);
     write(&mut out)?;

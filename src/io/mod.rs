@@ -10,8 +10,8 @@ pub mod shards;
 pub mod tables;
 
 pub use atomic::{
-    WriteError, all_or_nothing, check_output, file_identity, read_output, write_atomic,
-    write_atomic_now,
+    WriteError, all_or_nothing, check_output, file_identity, is_standard_output, read_output,
+    write_atomic, write_atomic_now,
 };
 pub use bounded::{read_bounded, read_text_bounded};
 pub use csv_rows::write_csv_rows;

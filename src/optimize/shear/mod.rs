@@ -12,8 +12,8 @@
 //! spectrum has a basin narrower than a coarse grid step), and Brent's
 //! method in the last interval; polish (a, b)
 //! jointly with Nelder–Mead (both from argmin). Where J cannot tell the
-//! spectral start from the result (within two standard errors), the start
-//! is returned. The result is never worse than no shear: if
+//! spectral start from the result (within two standard errors) and the
+//! spectrum lies on one line, the start is returned. The result is never worse than no shear: if
 //! J(found) > J(0, 0), the search returns (0, 0).
 
 pub mod checked;
@@ -242,8 +242,10 @@ pub fn search_shear(
     // flat objective: a tiny aperture, or an estimated half's noise), the
     // spectrum's direction decides: two standard errors of the difference,
     // taken as if the two estimates were independent (they share their
-    // realizations, so the difference is less noisy than that).
-    if shear != initial {
+    // realizations, so the difference is less noisy than that). Only for a
+    // spectrum on one line: a double wedge's principal direction lies
+    // between its layers and is no layer's shear.
+    if shear != initial && !start.double_wedge {
         let at_start = objective.evaluate(initial)?;
         if at_start.value <= optimum.value + 2.0 * optimum.stderr.hypot(at_start.stderr) {
             shear = initial;
