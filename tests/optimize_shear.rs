@@ -232,6 +232,28 @@ fn double_wedges_are_told_from_single_layers() {
         let f = integrands::parse(spec).unwrap();
         let start = spectral_start(f.as_ref(), 64, 2.0);
         assert!(start.double_wedge, "{spec}: {:?}", start.planes[0]);
+        // Its two lines are the layers' slopes: to the scan's 0.005 step on
+        // box and disk apertures; a Gaussian's energy lies at k_x ≤ ~10,
+        // where bands of width 1 resolve the slope to ~0.05 (measured
+        // −0.665 and 0.65 for ±0.7).
+        let mut lines = start.planes[0].lines.clone();
+        let mut layers: Vec<f64> = f
+            .light_field()
+            .unwrap()
+            .layer_shears()
+            .iter()
+            .map(|s| -s[0])
+            .collect();
+        lines.sort_by(f64::total_cmp);
+        layers.sort_by(f64::total_cmp);
+        assert!(
+            lines.len() == 2
+                && lines
+                    .iter()
+                    .zip(&layers)
+                    .all(|(l, c)| (l - c).abs() <= 0.06),
+            "{spec}: lines {lines:?} against the layers' {layers:?}"
+        );
         let s = registry::build("umj", 64, Some(4), &[]).unwrap();
         let objective = ShearObjective::new(
             f.as_ref(),
@@ -481,10 +503,20 @@ fn the_search_widens_its_range_warns_and_handles_degenerate_integrands() {
         cut.warnings
     );
     // Constant in (x, y): every shear gives 0; no shear, no ratio.
-    let constant = run("defocus:shape=box,size=1,c=0.3", None);
-    assert_eq!(constant.found.shear, [0.0, 0.0]);
-    assert!(constant.report["reduction"].is_null());
-    assert!(constant.warnings.iter().any(|w| w.contains("constant")));
+    for spec in [
+        "defocus:shape=box,size=1,c=0.3",
+        // Two constant layers: the variance sums to rounding, not to 0.
+        "layers:shape=box,size=1,c1=0.5,c2=-0.2",
+    ] {
+        let constant = run(spec, None);
+        assert_eq!(constant.found.shear, [0.0, 0.0], "{spec}");
+        assert!(constant.report["reduction"].is_null(), "{spec}");
+        assert!(
+            constant.warnings.iter().any(|w| w.contains("constant")),
+            "{spec}: {:?}",
+            constant.warnings
+        );
+    }
     // An aperture whose spectrum lies beyond the sum: J cannot tell shears
     // apart, so the spectrum's direction decides, with a warning.
     let hairline = run("defocus:shape=box,size=0.0001,c=0.7931", None);
@@ -504,6 +536,23 @@ fn the_search_widens_its_range_warns_and_handles_degenerate_integrands() {
             .any(|w| w.contains("truncation bound")),
         "{:?}",
         hairline.warnings
+    );
+    // An estimated (x, y) half on a smooth aperture: J is nearly flat about
+    // −c, and the search must not trade the line's exact shear for a point
+    // J cannot tell from it (it returned −1.1857 here, J 2.1% higher, with
+    // the principal direction as the fallback).
+    let sobol = registry::build("padded:xy=sobol,uv=sobol", 64, Some(4), &[]).unwrap();
+    let f = integrands::parse("defocus:shape=gaussian,size=0.3,c=1.2").unwrap();
+    let estimated =
+        search_and_check(f.as_ref(), sobol.as_ref(), "sobol", 7, None, 0, &|_| {}).unwrap();
+    assert!(
+        estimated
+            .found
+            .shear
+            .iter()
+            .all(|a| (a + 1.2).abs() <= 0.002),
+        "{:?}",
+        estimated.found.shear
     );
     // In focus: the analytic shear is 0, not -0.
     let focus = run("defocus:shape=disk,size=0.3,c=0", None);

@@ -129,7 +129,10 @@ impl SetSource {
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    super::args::check_outputs([a.csv.as_deref(), a.png.as_deref()])?;
+    super::args::check_outputs_beside(
+        [a.csv.as_deref(), a.png.as_deref()],
+        a.points.iter().map(|p| Some(p.as_path())),
+    )?;
     a.draw.check_results_memory()?;
     let members = super::args::family_members(a.members, a.family.as_deref())?;
     if a.family.is_some() {

@@ -11,9 +11,9 @@
 //! ranks its deepest local minima), 0.01 around the best on J (a hairline
 //! spectrum has a basin narrower than a coarse grid step), and Brent's
 //! method in the last interval; polish (a, b)
-//! jointly with Nelder–Mead (both from argmin). Where J cannot tell the
-//! spectral start from the result (within two standard errors) and the
-//! spectrum lies on one line, the start is returned. The result is never worse than no shear: if
+//! jointly with Nelder–Mead (both from argmin). Where the spectrum lies on
+//! one line and J cannot tell that line's shear from the result (within
+//! two standard errors), the line's shear is returned. The result is never worse than no shear: if
 //! J(found) > J(0, 0), the search returns (0, 0).
 
 pub mod checked;
@@ -57,8 +57,8 @@ pub struct ShearResult {
     pub initial: ([f64; 2], f64),
     /// J at (a ∓ 0.01, b) and (a, b ∓ 0.01): how sharp the optimum is.
     pub sensitivity: [f64; 4],
-    /// Whether the search fell back to no shear (nothing it found was
-    /// better).
+    /// Whether the search fell back to no shear (what it found had J
+    /// above the unsheared one).
     pub kept_unsheared: bool,
     /// Objective evaluations.
     pub evaluations: u64,
@@ -238,18 +238,19 @@ pub fn search_shear(
         }
     }
     let mut optimum = objective.evaluate(shear)?;
-    // Where J cannot tell the spectral start from what the scans found (a
+    // Where J cannot tell the spectrum's line from what the scans found (a
     // flat objective: a tiny aperture, or an estimated half's noise), the
-    // spectrum's direction decides: two standard errors of the difference,
-    // taken as if the two estimates were independent (they share their
-    // realizations, so the difference is less noisy than that). Only for a
-    // spectrum on one line: a double wedge's principal direction lies
-    // between its layers and is no layer's shear.
-    if shear != initial && !start.double_wedge {
-        let at_start = objective.evaluate(initial)?;
-        if at_start.value <= optimum.value + 2.0 * optimum.stderr.hypot(at_start.stderr) {
-            shear = initial;
-            optimum = at_start;
+    // line decides: within two standard errors combined as if the two
+    // estimates were independent (they share their realizations, so this
+    // is wider than the difference's own). Only for a spectrum on one line
+    // (a single layer's, whose shear −c is its slope): a double wedge has
+    // no one line.
+    let line = clamp(start.line_shear());
+    if shear != line && !start.double_wedge {
+        let at_line = objective.evaluate(line)?;
+        if at_line.value <= optimum.value + 2.0 * optimum.stderr.hypot(at_line.stderr) {
+            shear = line;
+            optimum = at_line;
         }
     }
     let kept_unsheared = optimum.value > unsheared.value;

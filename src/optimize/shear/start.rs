@@ -17,7 +17,8 @@
 //!   Σ_(k_x≠0) Σ_(k_u) |E(k) − E_col(k_x)·sinc²(π(k_u − s·k_x))| / Σ E,
 //!   is near 0 for one layer (only the box edge truncates the profile) and
 //!   large when the energy splits between two directions: the seed's
-//!   double wedge, where no single shear fits both layers. Where the line
+//!   double wedge, where no single shear fits both layers (its lines are
+//!   then the slopes whose bands hold the most energy). Where the line
 //!   leaves the box the model keeps the profile's share inside it, and the
 //!   best slope is refined by Brent's method between scan points (a flat
 //!   spectrum, a hairline aperture's, weighs every column alike, and a
@@ -46,6 +47,11 @@ const MIN_SEPARATION: f64 = 0.15;
 /// Slope resolution of the line scan (finer slopes come from Brent's
 /// method between scan points).
 const SLOPE_STEP: f64 = 0.005;
+/// The steepest slope the analysis scans: the defocus integrand's |c| ≤ 16,
+/// and at 16 a line leaves the box |k|∞ ≤ 64 by k_x = 4. (A vertical
+/// principal direction, a symmetric double wedge's, would otherwise widen
+/// the scan to the search's limit of 64 and coarsen its step.)
+const MAX_SLOPE: f64 = 16.0;
 /// Most scan points on each side of slope 0: beyond
 /// [`SLOPE_STEP`]·[`MAX_SCAN`] the scan's step widens.
 const MAX_SCAN: f64 = 400.0;
@@ -80,6 +86,14 @@ pub struct SpectralStart {
 }
 
 impl SpectralStart {
+    /// The shear of each plane's first (strongest) line: −c for a single
+    /// defocus layer, where the principal direction of the moments is
+    /// tilted by the aperture's side lobes.
+    pub fn line_shear(&self) -> [f64; 2] {
+        let [x, y] = &self.planes;
+        [-x.lines[0], -y.lines[0]]
+    }
+
     /// Shears worth trying first: the principal one and each line's.
     pub fn candidates(&self) -> Vec<[f64; 2]> {
         let mut out = vec![self.shear];
@@ -96,8 +110,8 @@ impl SpectralStart {
 /// Reads the directions of a 4D integrand's spectrum on the slices
 /// k_y = k_v = 0 and k_x = k_u = 0 of the box |k|∞ ≤ `half`: slopes in
 /// [−`range`, `range`], widened to hold the principal direction (up to
-/// [`MAX_SHEAR_RANGE`]), so that the analysis describes the spectrum
-/// whatever range the search is given.
+/// [`MAX_SLOPE`]), so that the analysis describes the spectrum whatever
+/// range the search is given.
 pub fn spectral_start(f: &dyn Integrand, half: i64, range: f64) -> SpectralStart {
     let plane = |axis: usize| {
         let side = (2 * half + 1) as usize;
@@ -161,7 +175,7 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
     } else {
         MAX_SHEAR_RANGE.copysign(v[1] * v[0])
     };
-    let limit = range.max(1.25 * principal.abs() + 0.1).min(MAX_SHEAR_RANGE);
+    let limit = range.max(1.25 * principal.abs() + 0.1).min(MAX_SLOPE);
     let eigenvalue_ratio = if eigen.eigenvalues[big] > 0.0 {
         (eigen.eigenvalues[small] / eigen.eigenvalues[big]).max(0.0)
     } else {
@@ -194,11 +208,9 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
     let misfit = |s: f64| -> f64 {
         let mut total = 0.0;
         for &(k1, column, sum) in &columns {
-            let profile: Vec<f64> = (-half..=half).map(|k2| sinc2(k2 as f64 - s * k1)).collect();
-            let inside: f64 = profile.iter().sum();
+            let profile = in_box_profile(s * k1, half);
             for (&e, &p) in column.iter().zip(&profile) {
-                let model = if inside > 0.0 { sum * p / inside } else { 0.0 };
-                total += (e - model).abs();
+                total += (e - sum * p).abs();
             }
         }
         total / off_total
@@ -223,7 +235,19 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
             (0.0, f64::INFINITY),
             |acc, c| if c.1 < acc.1 { c } else { acc },
         );
-    let (s1, one_line_misfit) = refine_slope(&misfit, scanned, step, limit);
+    let (fitted, one_line_misfit) = refine_slope(&misfit, scanned, step, limit);
+    // One line: the fitted slope. A double wedge: the fit lies between the
+    // layers, so the first line is the slope whose band holds the most
+    // energy (the strongest layer), the second the most of the rest.
+    let s1 = if one_line_misfit > DOUBLE_WEDGE_MISFIT {
+        slopes
+            .iter()
+            .map(|&s| (s, share(s, None)))
+            .fold((fitted, 0.0), |acc, c| if c.1 > acc.1 { c } else { acc })
+            .0
+    } else {
+        fitted
+    };
     let first_line_share = share(s1, None);
     let (s2, second_line_share) = slopes
         .iter()
@@ -278,12 +302,20 @@ fn refine_slope(
     }
 }
 
-/// sinc²(πz), 1 at 0.
-fn sinc2(z: f64) -> f64 {
-    if z.abs() < 1e-8 {
-        return 1.0;
+/// The profile sinc²(π(k₂ − x)) over the integers k₂ of [−half, half],
+/// scaled to sum to 1 there (a line that leaves the box keeps its in-box
+/// share). On the integers sin²(π(k₂ − x)) is the same for every k₂, so the
+/// scaled profile is 1/(k₂ − x)² over its sum, with no division by a
+/// vanishing sine; at an integer x it is 1 at k₂ = x, or 0 everywhere when
+/// x lies outside the box (the line's energy is then all outside).
+fn in_box_profile(x: f64, half: i64) -> Vec<f64> {
+    let nearest = x.round();
+    if (x - nearest).abs() < 1e-9 {
+        return (-half..=half)
+            .map(|k2| if k2 as f64 == nearest { 1.0 } else { 0.0 })
+            .collect();
     }
-    let r = z - 2.0 * (0.5 * z).round();
-    let s = (std::f64::consts::PI * r).sin() / (std::f64::consts::PI * z);
-    s * s
+    let raw: Vec<f64> = (-half..=half).map(|k2| (k2 as f64 - x).powi(-2)).collect();
+    let total: f64 = raw.iter().sum();
+    raw.into_iter().map(|r| r / total).collect()
 }
