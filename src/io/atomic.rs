@@ -289,8 +289,6 @@ pub fn check_output(path: &Path) -> Result<(), WriteError> {
     })
 }
 
-/// Follows symbolic links (up to 32) to the path that will be written; a
-/// dangling link resolves to where its target would be.
 /// The file `path` names, to tell whether two paths are one file: links
 /// resolved and the folder made canonical. `None` for a device, FIFO or
 /// socket (`-o /dev/null` may be named twice) and for a path whose folder
@@ -308,6 +306,9 @@ pub fn file_identity(path: &Path) -> Option<PathBuf> {
     Some(dir.join(name))
 }
 
+/// Follows symbolic links (up to 32) to the path that will be written; a
+/// dangling link resolves to where its target would be, and a link to a
+/// device, FIFO or socket stops at the link (written through it).
 fn resolve_links(path: &Path) -> io::Result<PathBuf> {
     let mut current = path.to_path_buf();
     for _ in 0..32 {
