@@ -9,16 +9,14 @@ use serde_json::json;
 
 use super::args::DrawArgs;
 use super::progress;
+use super::source::realization_error;
 use varspec::integrands;
 use varspec::io::write_atomic;
 use varspec::registry;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
-use varspec::rng::set_rng;
-use varspec::samplers;
+use varspec::source::Source;
 use varspec::square::{Family, family_mse};
-use varspec::variance::{
-    VarianceError, VarianceForm, fit_slope, sampler_variance, theoretical_rate,
-};
+use varspec::variance::{VarianceForm, fit_slope, sampler_variance, theoretical_rate};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum MethodArg {
@@ -98,36 +96,6 @@ enum Subject {
     Square(Family),
 }
 
-/// The sets of one level: a sampler's realizations, or a file's sets.
-enum SetSource {
-    Sampler(Box<dyn samplers::Sampler>),
-    File(Vec<varspec::PointSet>),
-}
-
-impl SetSource {
-    fn n(&self) -> usize {
-        match self {
-            SetSource::Sampler(s) => s.points_per_set(),
-            SetSource::File(sets) => sets[0].len(),
-        }
-    }
-
-    /// Realizations: `--sets` of a sampler, every set of a file.
-    fn count(&self, sets: usize) -> usize {
-        match self {
-            SetSource::Sampler(_) => sets,
-            SetSource::File(f) => f.len(),
-        }
-    }
-
-    fn set(&self, r: usize, seed: u64) -> Result<varspec::PointSet, VarianceError> {
-        match self {
-            SetSource::Sampler(s) => Ok(s.sample(&mut set_rng(seed, r as u64))?),
-            SetSource::File(sets) => Ok(sets[r].clone()),
-        }
-    }
-}
-
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs_beside(
         [a.csv.as_deref(), a.png.as_deref()],
@@ -200,7 +168,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     }
                     e => e.into(),
                 })?;
-                (SetSource::Sampler(sampler), *requested)
+                let source = Source::Sampler {
+                    name: format!("{label} N={}", sampler.points_per_set()),
+                    sampler,
+                    seed: a.draw.seed(),
+                    sets: a.draw.sets(),
+                    dims: None,
+                };
+                (source, *requested)
             }
             Level::File(path) => {
                 let sets = varspec::io::read_point_sets_of_dim(path, dim)?;
@@ -213,16 +188,18 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     );
                 }
                 let n = sets[0].len();
-                (SetSource::File(sets), n)
+                let source = Source::File {
+                    sets,
+                    dims: None,
+                    name: path.display().to_string(),
+                };
+                (source, n)
             }
         };
-        let (n, count) = (source.n(), source.count(a.draw.sets()));
-        let realization = |r: usize| -> Result<_, VarianceError> { source.set(r, a.draw.seed()) };
+        let (n, count) = (source.points_per_set(), source.count());
         let (variance, stderr, truncation_bound) = match (&subject, method) {
             (Subject::Square(family), _) => {
-                let sets = (0..count)
-                    .map(&realization)
-                    .collect::<Result<Vec<_>, _>>()?;
+                let sets = source.realizations()?;
                 let e = family_mse(&sets, family, members, a.draw.seed());
                 (e.mse, e.stderr, 0.0)
             }
@@ -235,7 +212,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         }),
                     },
                 };
-                let e = sampler_variance(f.as_ref(), count, form, realization)?;
+                let e = sampler_variance(f.as_ref(), count, form, |r| {
+                    source.get(r).map_err(|e| realization_error(r, e))
+                })?;
                 (e.variance, e.stderr, e.truncation_bound)
             }
         };

@@ -7,11 +7,10 @@ use anyhow::{anyhow, bail};
 use clap::ValueEnum;
 use serde_json::{Value, json};
 
-use super::source::SourceArgs;
+use super::source::{SourceArgs, realization_error};
 use varspec::PointSet;
 use varspec::integrands::{self, Integrand};
 use varspec::scene::pixel::PixelIntegrand;
-use varspec::source::SourceError;
 use varspec::variance::{
     DEFAULT_SHIFT_SEED, VarianceError, empirical_shifting, fourier_parts, radial_from, spatial,
 };
@@ -103,18 +102,6 @@ pub struct Args {
     /// Print one JSON object (the scripting interface).
     #[arg(long)]
     json: bool,
-}
-
-/// A realization's failure as the predictor's error: a sampler failure
-/// stays one, anything else names the realization.
-fn lift(index: usize, e: SourceError) -> VarianceError {
-    match e {
-        SourceError::Sampler(s) => VarianceError::Sampler(s),
-        other => VarianceError::Realization {
-            index,
-            message: other.to_string(),
-        },
-    }
 }
 
 /// A standard error over `sets` realizations: unknown (JSON null) from one.
@@ -255,7 +242,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.realizations,
             DEFAULT_SHIFT_SEED,
             &shifted,
-            |r| source.get_cyclic(r).map_err(|e| lift(r, e)),
+            |r| source.get_cyclic(r).map_err(|e| realization_error(r, e)),
         )?;
         out.insert(
             "empirical".into(),

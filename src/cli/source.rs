@@ -10,7 +10,8 @@ use super::args;
 use varspec::PointSet;
 use varspec::io::read_point_sets;
 use varspec::registry;
-use varspec::source::Source;
+use varspec::source::{Source, SourceError};
+use varspec::variance::VarianceError;
 
 #[derive(clap::Args)]
 pub struct SourceArgs {
@@ -179,5 +180,17 @@ impl SourceArgs {
             );
         }
         Ok(source)
+    }
+}
+
+/// A realization's failure as a predictor's error: a sampler failure
+/// stays one, anything else names the realization.
+pub fn realization_error(index: usize, e: SourceError) -> VarianceError {
+    match e {
+        SourceError::Sampler(s) => VarianceError::Sampler(s),
+        other => VarianceError::Realization {
+            index,
+            message: other.to_string(),
+        },
     }
 }

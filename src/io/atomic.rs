@@ -178,29 +178,21 @@ where
         cause,
     };
     // This process's standard output, whatever it is (a pipe, a terminal, a
-    // file the shell opened for >>): written through the descriptor, never
-    // replaced by a rename or reopened at offset 0.
-    if is_standard_output(path) {
-        if staging() {
-            let mut bytes = Vec::new();
-            write(&mut bytes).map_err(fail)?;
-            stage(Staged::InPlace {
-                path: path.to_path_buf(),
-                target: path.to_path_buf(),
-                bytes,
-            });
-            return Ok(());
-        }
-        return write_in_place(path, write).map_err(fail);
-    }
-    let target = resolve_links(path).map_err(fail)?;
+    // file the shell opened for >>), is written in place through the
+    // descriptor, never replaced by a rename or reopened at offset 0.
+    let stdout = is_standard_output(path);
+    let target = if stdout {
+        path.to_path_buf()
+    } else {
+        resolve_links(path).map_err(fail)?
+    };
     match fs::metadata(&target) {
         Ok(meta) if meta.is_dir() => {
             return Err(fail(io::Error::other(
                 "it is a folder; give a file name inside it",
             )));
         }
-        Ok(meta) if !meta.is_file() => {
+        Ok(meta) if stdout || !meta.is_file() => {
             if staging() {
                 let mut bytes = Vec::new();
                 write(&mut bytes).map_err(fail)?;
