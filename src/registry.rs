@@ -475,6 +475,7 @@ mod tests {
             e,
             SamplerError::Count {
                 sampler: "jitter",
+                dim: 2,
                 n: 1000,
                 rule: "N = m^d",
                 below: Some(961),

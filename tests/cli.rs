@@ -139,6 +139,20 @@ fn bad_requests_fail_with_a_specific_message() {
             "nearest valid N: 961 or 1024",
         ),
         (vec!["sample", "jitter", "-n", "30", "-d", "3"], "27 or 64"),
+        // predict draws jitter in the integrand's dimension (4 here, though
+        // no -d was given): the refusal says which, as N = m^d depends on it.
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "200",
+                "--integrand",
+                "defocus:c=0.5",
+            ],
+            "jitter in 4D: N = 200 does not fit",
+        ),
         (vec!["sample", "nope", "-n", "10"], "known samplers: random"),
         (
             vec!["sample", "cmj", "-n", "10", "-d", "3"],

@@ -283,7 +283,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         "95% CI [{:.4e}, {high:.4e}]",
                         v["ci_low"].as_f64().unwrap_or(0.0)
                     ),
-                    None => "every realization gave the same estimate: no upper bound (raise --realizations)".to_string(),
+                    None => "every realization gave the same estimate, so the interval has no upper end (the variance is 0 if the integrand is constant; otherwise raise --realizations)".to_string(),
                 },
                 _ if v.get("skipped").is_some() => {
                     v["skipped"].as_str().unwrap_or_default().to_string()

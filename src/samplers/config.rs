@@ -124,6 +124,7 @@ impl Config {
     ) -> SamplerError {
         SamplerError::Count {
             sampler: self.sampler,
+            dim: self.dim,
             n: self.n,
             rule,
             below,

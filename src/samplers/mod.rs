@@ -96,10 +96,12 @@ pub enum SamplerError {
         max: usize,
     },
     /// N does not fit the sampler's structure.
-    #[error("{sampler}: N = {n} does not fit ({rule}); nearest valid N: {}", nearest(*below, *above))]
+    #[error("{sampler} in {dim}D: N = {n} does not fit ({rule}); nearest valid N: {}", nearest(*below, *above))]
     Count {
         /// Sampler name.
         sampler: &'static str,
+        /// The dimension the set was asked in (the rule often depends on it).
+        dim: usize,
         /// Requested N.
         n: usize,
         /// The constraint.
