@@ -560,4 +560,9 @@ fn the_search_widens_its_range_warns_and_handles_degenerate_integrands() {
         serde_json::to_string(&focus.report["analytic_shear"]).unwrap(),
         "[[0.0,0.0]]"
     );
+    // Nor is the spectral start.
+    assert_eq!(
+        serde_json::to_string(&focus.report["initial_shear"]).unwrap(),
+        "[0.0,0.0]"
+    );
 }

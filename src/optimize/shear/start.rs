@@ -91,7 +91,7 @@ impl SpectralStart {
     /// tilted by the aperture's side lobes.
     pub fn line_shear(&self) -> [f64; 2] {
         let [x, y] = &self.planes;
-        [-x.lines[0], -y.lines[0]]
+        [shear_of(x.lines[0]), shear_of(y.lines[0])]
     }
 
     /// Shears worth trying first: the principal one and each line's.
@@ -100,11 +100,17 @@ impl SpectralStart {
         let [x, y] = &self.planes;
         for &sx in &x.lines {
             for &sy in &y.lines {
-                out.push([-sx, -sy]);
+                out.push([shear_of(sx), shear_of(sy)]);
             }
         }
         out
     }
+}
+
+/// The shear that flattens a line of slope k_u/k_x = `slope`: −slope,
+/// written 0 − slope so that a zero slope gives +0, not −0, in the output.
+fn shear_of(slope: f64) -> f64 {
+    0.0 - slope
 }
 
 /// Reads the directions of a 4D integrand's spectrum on the slices
@@ -130,7 +136,7 @@ pub fn spectral_start(f: &dyn Integrand, half: i64, range: f64) -> SpectralStart
         directions(&grid, half, range)
     };
     let planes = [plane(0), plane(1)];
-    let shear = [-planes[0].principal, -planes[1].principal];
+    let shear = [shear_of(planes[0].principal), shear_of(planes[1].principal)];
     let double_wedge = planes.iter().any(|p| p.lines.len() > 1);
     SpectralStart {
         planes,
