@@ -369,6 +369,44 @@ fn a_scene_in_millimetres_renders_as_in_metres() {
     }
 }
 
+/// Directions are directions at any length: an `up` of 1e-200 or 1e200 and
+/// a light normal of 1e-10 render exactly as unit ones (they underflowed
+/// to a blank image, overflowed to a degenerate one, or were refused).
+#[test]
+fn tiny_and_huge_directions_render_as_unit_ones() {
+    use varspec::scene::analysis::SampleShear;
+    use varspec::scene::render::render;
+    let text = |up: &str, normal: &str| {
+        format!(
+            r#"{{
+  "camera": {{"resolution": [8, 8], "fov_degrees": 40, "position": [0, 0, 0],
+              "look_at": [0, 0, -1], "up": {up}, "focal_distance": 4, "aperture": 0}},
+  "integrand": "light",
+  "ambient": 0.5,
+  "objects": [{{"shape": "quad", "scale": [10, 10, 1], "translate": [0, 0, -4],
+                "material": {{"texture": "checker", "period": 0.7, "low": 0.2, "high": 0.9}}}}],
+  "lights": [{{"shape": "square", "centre": [0.2, 0, -2], "normal": {normal}, "size": 1, "radiance": 1}}]
+}}"#
+        )
+    };
+    let sampler = registry::build("random", 16, Some(4), &[]).unwrap();
+    let image = |up: &str, normal: &str| {
+        let scene = Scene::from_text(&text(up, normal), "directions").unwrap();
+        render(&scene, sampler.as_ref(), &vec![SampleShear::NONE; 64], 2, 0)
+            .unwrap()
+            .pixels
+    };
+    let unit = image("[0, 1, 0]", "[0, 0, -1]");
+    assert!(unit.iter().all(|v| v.is_finite() && *v > 0.0), "{unit:?}");
+    for (up, normal) in [
+        ("[0, 1e-200, 0]", "[0, 0, -1]"),
+        ("[0, 1e200, 0]", "[0, 0, -1e200]"),
+        ("[0, 1, 0]", "[0, 0, -1e-10]"),
+    ] {
+        assert_eq!(image(up, normal), unit, "up {up}, normal {normal}");
+    }
+}
+
 /// A striped 3 × 2 rectangle at depth 6, its edges inside the view
 /// (misses see the ambient 1; the stripes are 0.2 and 0.8), its quad given by `shape` (e.g.
 /// `"shape": "quad"` or an OBJ file).
@@ -443,6 +481,16 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
             "nan.obj",
             "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
             "finite",
+        ),
+        (
+            "huge.obj",
+            "v 0 0 0\nv 2e9 0 0\nv 0 1 0\nf 1 2 3\n",
+            "magnitude at most 1e9",
+        ),
+        (
+            "flat.obj",
+            "v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\nf 1 1 2\n",
+            "(all 2 faces of",
         ),
     ];
     let mut cases: Vec<(String, &str)> = vec![

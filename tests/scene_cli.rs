@@ -177,6 +177,28 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
             "\"ambiant\": 1.0",
             "unknown field `ambiant`",
         ),
+        // A zero `up` used to pass the parallel test (0 < 0 is false) and
+        // render every pixel as background; finite extremes overflowed.
+        (
+            "\"look_at\": [0, 0, -1],",
+            "\"look_at\": [0, 0, -1], \"up\": [0, 0, 0],",
+            "camera.up = [0.0, 0.0, 0.0]: a non-zero direction",
+        ),
+        (
+            "\"ambient\": 1.0",
+            "\"ambient\": 1e308",
+            "ambient = 1e308: a radiance from 0 to 1e12",
+        ),
+        (
+            "\"translate\": [0, 0, -8]",
+            "\"translate\": [0, 0, -1e200]",
+            "objects[0].translate = [0.0, 0.0, -1e200]: finite numbers of magnitude at most 1e9",
+        ),
+        (
+            "\"focal_distance\": 4",
+            "\"focal_distance\": 1e200",
+            "camera.focal_distance = 1e200: a positive distance of at most 1e9",
+        ),
         (
             "\"subdivisions\": 4",
             "\"subdivisions\": \"four\"",

@@ -8,7 +8,7 @@
 //! fronto-parallel plane is constant (the `defocus` integrand's form with
 //! c = κ); the sample shear that follows them is a = b = −κ.
 
-use super::description::{CameraFile, cross, norm, sub};
+use super::description::{CameraFile, cross, norm, sub, unit};
 use super::geometry::dot;
 
 /// A camera ray: origin on the lens, unit direction.
@@ -36,13 +36,16 @@ pub struct Camera {
 
 impl Camera {
     /// From a checked camera description.
+    ///
+    /// # Panics
+    /// On a description its check refuses (a zero or non-finite view or
+    /// `up`, or `up` parallel to the view).
     pub fn new(c: &CameraFile) -> Camera {
-        let unit = |v: [f64; 3]| {
-            let n = norm(v);
-            [v[0] / n, v[1] / n, v[2] / n]
-        };
+        // The description's check refused zero, non-finite and parallel
+        // directions.
+        let unit = |v| unit(v).expect("a checked camera has non-zero directions");
         let forward = unit(sub(c.look_at, c.position));
-        let right = unit(cross(forward, c.up));
+        let right = unit(cross(forward, unit(c.up)));
         let down = cross(forward, right);
         let [width, height] = c.resolution;
         let pixel =

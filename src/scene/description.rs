@@ -2,6 +2,7 @@
 //! names it (docs/formats.md, "Scene file"). Grey-scale radiance throughout:
 //! the analysis works on one scalar integrand per pixel.
 
+use crate::spec_params::SpecValue;
 use serde::Deserialize;
 
 /// A whole scene as written in its file.
@@ -281,40 +282,45 @@ impl SceneFile {
         if !(c.fov_degrees > 0.0 && c.fov_degrees < 180.0) {
             return Err(bad(
                 "camera.fov_degrees".into(),
-                c.fov_degrees.to_string(),
+                SpecValue(c.fov_degrees).to_string(),
                 "a number of degrees in (0, 180)",
             ));
         }
-        finite3("camera.position", &c.position).map_err(|(f, v)| bad(f, v, FINITE))?;
-        finite3("camera.look_at", &c.look_at).map_err(|(f, v)| bad(f, v, FINITE))?;
-        finite3("camera.up", &c.up).map_err(|(f, v)| bad(f, v, FINITE))?;
-        let view = sub(c.look_at, c.position);
-        if norm(view) < 1e-9 {
+        bounded3("camera.position", &c.position).map_err(|(f, v)| bad(f, v, BOUNDED))?;
+        bounded3("camera.look_at", &c.look_at).map_err(|(f, v)| bad(f, v, BOUNDED))?;
+        let Some(view) = unit(sub(c.look_at, c.position)) else {
             return Err(bad(
                 "camera.look_at".into(),
                 format!("{:?}", c.look_at),
                 "a point other than camera.position",
             ));
-        }
-        if norm(cross(view, c.up)) < 1e-9 * norm(view) * norm(c.up) {
+        };
+        let up = unit(c.up).ok_or_else(|| {
+            bad(
+                "camera.up".into(),
+                format!("{:?}", c.up),
+                "a non-zero direction of finite numbers",
+            )
+        })?;
+        if norm(cross(view, up)) < 1e-9 {
             return Err(bad(
                 "camera.up".into(),
                 format!("{:?}", c.up),
                 "a direction not parallel to the view (look_at − position)",
             ));
         }
-        if !(c.focal_distance.is_finite() && c.focal_distance > 0.0) {
+        if !(c.focal_distance > 0.0 && c.focal_distance <= MAX_LENGTH) {
             return Err(bad(
                 "camera.focal_distance".into(),
-                c.focal_distance.to_string(),
-                "a positive distance",
+                SpecValue(c.focal_distance).to_string(),
+                &format!("a positive distance of at most {MAX_LENGTH:e}"),
             ));
         }
-        if !(c.aperture.is_finite() && c.aperture >= 0.0) {
+        if !(c.aperture >= 0.0 && c.aperture <= MAX_LENGTH) {
             return Err(bad(
                 "camera.aperture".into(),
-                c.aperture.to_string(),
-                "a half-side ≥ 0 (0: a pinhole)",
+                SpecValue(c.aperture).to_string(),
+                &format!("a half-side from 0 (a pinhole) to {MAX_LENGTH:e}"),
             ));
         }
         if self.objects.is_empty() {
@@ -322,19 +328,19 @@ impl SceneFile {
         }
         for (i, o) in self.objects.iter().enumerate() {
             let field = |name: &str| format!("objects[{i}].{name}");
-            finite3(&field("translate"), &o.translate).map_err(|(f, v)| bad(f, v, FINITE))?;
-            if o.scale.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+            bounded3(&field("translate"), &o.translate).map_err(|(f, v)| bad(f, v, BOUNDED))?;
+            if o.scale.iter().any(|s| !(*s > 0.0 && *s <= MAX_LENGTH)) {
                 return Err(bad(
                     field("scale"),
                     format!("{:?}", o.scale),
-                    "three positive scale factors",
+                    &format!("three positive scale factors of at most {MAX_LENGTH:e}"),
                 ));
             }
             if !o.rotate_y_degrees.is_finite() {
                 return Err(bad(
                     field("rotate_y_degrees"),
-                    o.rotate_y_degrees.to_string(),
-                    FINITE,
+                    SpecValue(o.rotate_y_degrees).to_string(),
+                    "a finite number of degrees",
                 ));
             }
             match (o.shape, &o.file) {
@@ -367,30 +373,34 @@ impl SceneFile {
         }
         for (i, l) in self.lights.iter().enumerate() {
             let field = |name: &str| format!("lights[{i}].{name}");
-            finite3(&field("centre"), &l.centre).map_err(|(f, v)| bad(f, v, FINITE))?;
-            if norm(l.normal) < 1e-9 || l.normal.iter().any(|v| !v.is_finite()) {
+            bounded3(&field("centre"), &l.centre).map_err(|(f, v)| bad(f, v, BOUNDED))?;
+            if unit(l.normal).is_none() {
                 return Err(bad(
                     field("normal"),
                     format!("{:?}", l.normal),
-                    "a non-zero direction",
+                    "a non-zero direction of finite numbers",
                 ));
             }
-            if !(l.size.is_finite() && l.size > 0.0) {
-                return Err(bad(field("size"), l.size.to_string(), "a positive size"));
+            if !(l.size > 0.0 && l.size <= MAX_LENGTH) {
+                return Err(bad(
+                    field("size"),
+                    SpecValue(l.size).to_string(),
+                    &format!("a positive size of at most {MAX_LENGTH:e}"),
+                ));
             }
-            if !(l.radiance.is_finite() && l.radiance >= 0.0) {
+            if !(l.radiance >= 0.0 && l.radiance <= MAX_RADIANCE) {
                 return Err(bad(
                     field("radiance"),
-                    l.radiance.to_string(),
-                    "a radiance ≥ 0",
+                    SpecValue(l.radiance).to_string(),
+                    &format!("a radiance from 0 to {MAX_RADIANCE:e}"),
                 ));
             }
         }
-        if !(self.ambient.is_finite() && self.ambient >= 0.0) {
+        if !(self.ambient >= 0.0 && self.ambient <= MAX_RADIANCE) {
             return Err(bad(
                 "ambient".into(),
-                self.ambient.to_string(),
-                "a radiance ≥ 0",
+                SpecValue(self.ambient).to_string(),
+                &format!("a radiance from 0 to {MAX_RADIANCE:e}"),
             ));
         }
         match self.integrand {
@@ -401,7 +411,7 @@ impl SceneFile {
             )),
             IntegrandKind::Light if c.aperture > 0.0 => Err(bad(
                 "camera.aperture".into(),
-                c.aperture.to_string(),
+                SpecValue(c.aperture).to_string(),
                 "0 for the \"light\" integrand (its (u, v) sample the light, not the lens)",
             )),
             _ => Ok(()),
@@ -415,7 +425,7 @@ impl MaterialFile {
             if (0.0..=1.0).contains(&v) {
                 Ok(())
             } else {
-                Err((name, v.to_string(), "an albedo in [0, 1]"))
+                Err((name, SpecValue(v).to_string(), "an albedo in [0, 1]"))
             }
         };
         match *self {
@@ -423,7 +433,7 @@ impl MaterialFile {
             MaterialFile::Checker { period, low, high }
             | MaterialFile::Stripes { period, low, high } => {
                 if !(period.is_finite() && period > 0.0) {
-                    return Err(("period", period.to_string(), "a positive period"));
+                    return Err(("period", SpecValue(period).to_string(), "a positive period"));
                 }
                 albedo("low", low)?;
                 albedo("high", high)
@@ -432,14 +442,42 @@ impl MaterialFile {
     }
 }
 
-const FINITE: &str = "finite numbers";
+/// The largest magnitude of a length or coordinate in a scene: the BVH
+/// intersects in f32, whose products of coordinates overflow near 1e19
+/// and whose rounding at 1e9 is already 64 units.
+pub const MAX_LENGTH: f64 = 1e9;
+/// The largest radiance (lights and ambient): sums of many samples stay
+/// far from overflow.
+pub const MAX_RADIANCE: f64 = 1e12;
 
-fn finite3(field: &str, v: &[f64; 3]) -> Result<(), (String, String)> {
-    if v.iter().all(|x| x.is_finite()) {
+const BOUNDED: &str = "finite numbers of magnitude at most 1e9 (the BVH intersects in f32)";
+
+fn bounded3(field: &str, v: &[f64; 3]) -> Result<(), (String, String)> {
+    if v.iter().all(|x| x.abs() <= MAX_LENGTH) {
         Ok(())
     } else {
         Err((field.into(), format!("{v:?}")))
     }
+}
+
+/// `v` over its length, or `None` for a zero or non-finite vector. Where
+/// the squared length could underflow or overflow (a 1e-200 or 1e200
+/// direction) the components are first divided by the largest magnitude.
+pub(crate) fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+    if v.iter().any(|c| !c.is_finite()) {
+        return None;
+    }
+    let n = norm(v);
+    if n > 1e-150 && n < 1e150 {
+        return Some(v.map(|c| c / n));
+    }
+    let big = v.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+    if big == 0.0 {
+        return None;
+    }
+    let w = v.map(|c| c / big);
+    let n = norm(w);
+    Some(w.map(|c| c / n))
 }
 
 pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use super::description::{ObjectFile, SceneError};
+use super::description::{MAX_LENGTH, ObjectFile, SceneError, cross, norm, sub};
 use super::geometry::{ModelTriangle, shape_triangles};
 
 /// An upper bound on the bytes a mesh takes per byte of its OBJ text: a
@@ -19,7 +19,8 @@ const BYTES_PER_OBJ_BYTE: f64 = 32.0;
 ///
 /// # Errors
 /// [`SceneError::Field`] on `objects[index].file`: unreadable, too large
-/// for memory, malformed, no faces, a non-finite position or a face that
+/// for memory, malformed, no faces (or only faces of zero area), a
+/// position that is not finite or beyond [`MAX_LENGTH`], or a face that
 /// refers to a missing vertex.
 pub fn object_triangles(
     object: &ObjectFile,
@@ -62,9 +63,12 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
     let mut triangles = Vec::new();
     for model in &models {
         let positions = &model.mesh.positions;
-        if let Some(bad) = positions.iter().find(|v| !v.is_finite()) {
+        if let Some(bad) = positions
+            .iter()
+            .find(|v| !v.is_finite() || f64::from(v.abs()) > MAX_LENGTH)
+        {
             return Err(format!(
-                "finite vertex positions (model `{}` has {bad})",
+                "finite vertex positions of magnitude at most {MAX_LENGTH:e} (model `{}` has {bad})",
                 model.name
             ));
         }
@@ -90,6 +94,16 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         return Err(format!(
             "a mesh with at least one face ({} has none)",
             path.display()
+        ));
+    }
+    if triangles
+        .iter()
+        .all(|&[a, b, c]| norm(cross(sub(b, a), sub(c, a))) == 0.0)
+    {
+        return Err(format!(
+            "a mesh with at least one face of non-zero area (all {1} faces of {0} have zero area)",
+            path.display(),
+            triangles.len()
         ));
     }
     Ok(triangles)

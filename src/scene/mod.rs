@@ -69,8 +69,7 @@ struct Light {
 
 impl Light {
     fn new(l: &LightFile) -> Light {
-        let n = description::norm(l.normal);
-        let normal = l.normal.map(|c| c / n);
+        let normal = description::unit(l.normal).expect("a checked light has a non-zero normal");
         // Any vector not parallel to the normal gives the frame.
         let helper = if normal[0].abs() < 0.9 {
             [1.0, 0.0, 0.0]
