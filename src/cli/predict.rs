@@ -90,9 +90,10 @@ pub struct Args {
     /// Which dimensions the empirical predictor's random shift moves: all
     /// (the estimator of every predictor), xy (dimensions 0 and 1: how
     /// sheared 4D sets, e.g. from `optimize shear -o`, are judged) or none
-    /// (a file's sets then count once each).
-    #[arg(long, value_enum, default_value_t = ShiftArg::All, conflicts_with = "family")]
-    shift: ShiftArg,
+    /// (a file's sets then count once each) [default: all; none for a
+    /// scene pixel, the estimator its render uses].
+    #[arg(long, value_enum, conflicts_with = "family")]
+    shift: Option<ShiftArg>,
     /// Fourier box |k| < K/2 (default 256 in 2D, 16 in 4D).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
@@ -135,24 +136,29 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let source = a.source.resolve(Some(f.dim()))?;
     let sets = source.count();
-    if a.shift != ShiftArg::All {
-        if a.method != MethodArg::Empirical {
+    // A render averages f over each pixel's set as it is drawn: a pixel's
+    // variance is that of the unshifted estimator.
+    let shift = a
+        .shift
+        .unwrap_or(if pixel { ShiftArg::None } else { ShiftArg::All });
+    if shift != ShiftArg::All {
+        if !(a.method == MethodArg::Empirical || pixel) {
             bail!(
                 "--shift {}: only the empirical predictor takes another shift; the Fourier, \
                  spatial and radial forms are of the estimator shifted in every dimension: add \
                  --method empirical",
-                a.shift
+                shift
                     .to_possible_value()
                     .map_or("?".into(), |v| v.get_name().to_string())
             );
         }
-        if a.shift == ShiftArg::None && a.source.file().is_some() && sets < 2 {
+        if shift == ShiftArg::None && a.source.file().is_some() && sets < 2 {
             bail!(
                 "--shift none: the file holds one set, so one estimate and no variance without a \
                  shift; give a file of 2 or more sets"
             );
         }
-        if a.shift == ShiftArg::None && a.source.file().is_some() && a.realizations > sets {
+        if shift == ShiftArg::None && a.source.file().is_some() && a.realizations > sets {
             bail!(
                 "--shift none --realizations {}: without a shift the file's {sets} set(s) give \
                  only {sets} distinct estimates, so repeating them would overstate the \
@@ -189,7 +195,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             )),
         );
     }
-    out.insert("estimator".into(), json!(a.shift.estimator()));
+    out.insert("estimator".into(), json!(shift.estimator()));
     if wants(MethodArg::Fourier) || wants(MethodArg::Radial) {
         let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
         let half = res.saturating_sub(1) / 2;
@@ -236,7 +242,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if wants(MethodArg::Empirical) {
         let start = Instant::now();
-        let shifted = a.shift.dims(f.dim());
+        let shifted = shift.dims(f.dim());
         let e = empirical_shifting(
             f.as_ref(),
             a.realizations,
@@ -256,16 +262,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         outln!("{}", serde_json::to_string_pretty(&Value::Object(out))?);
         return Ok(());
     }
+    // A sampler's sets are those the Fourier and spatial forms pass over;
+    // the empirical predictor alone draws its own realizations.
+    let drawn_label = if drawn.is_empty() && a.source.file().is_none() {
+        format!("{} realizations", a.realizations)
+    } else {
+        format!("{sets} sets")
+    };
     outln!(
-        "{} on {} ({}, {sets} sets), I {} {}",
+        "{} on {} ({}, {drawn_label}), I {} {}",
         f.spec(),
         source.name(),
         source.count_label(),
         if pixel { "≈" } else { "=" },
         varspec::spec_params::SpecValue(f.integral())
     );
-    if a.shift != ShiftArg::All {
-        outln!("  estimator: {}", a.shift.estimator());
+    if shift != ShiftArg::All {
+        outln!("  estimator: {}", shift.estimator());
     }
     for (key, extra) in [
         ("fourier", "truncation_bound"),

@@ -173,6 +173,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         e => e.into(),
     })?;
     let [w, h] = scene.camera().resolution();
+    // Read and check the reference before the renders, not after them.
+    let reference = match &a.reference {
+        Some(path) => {
+            let r = GreyImage::read_pfm(path).map_err(anyhow::Error::msg)?;
+            if (r.width, r.height) != (w, h) {
+                bail!(
+                    "{}: the reference is {}×{}, the scene renders {w}×{h}",
+                    path.display(),
+                    r.width,
+                    r.height
+                );
+            }
+            Some(r)
+        }
+        None => None,
+    };
     let start = Instant::now();
     let analysis = analyse(&scene);
     let shears = pixel_shears(&scene, sampler.as_ref(), policy, &analysis, a.seed)?;
@@ -210,21 +226,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(path) = &a.npy {
         image.write_npy(path)?;
     }
-    let reference = match &a.reference {
-        Some(path) => {
-            let r = GreyImage::read_pfm(path).map_err(anyhow::Error::msg)?;
-            if (r.width, r.height) != (w, h) {
-                bail!(
-                    "{}: the reference is {}×{}, the scene renders {w}×{h}",
-                    path.display(),
-                    r.width,
-                    r.height
-                );
-            }
-            Some(r)
-        }
-        None => None,
-    };
     let title = format!(
         "{}: {} at {} spp, shear {}",
         scene.name(),

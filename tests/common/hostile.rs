@@ -106,13 +106,17 @@ pub fn write_fixtures(dir: &Path) {
         "look_at": [0, 0, -1], "focal_distance": 4, "aperture": 0.06}, "integrand": "lens",
         "objects": [{"shape": "obj", "file": "m.obj", "translate": [0, 0, -4],
         "material": {"texture": "checker", "period": 0.5, "low": 0.2, "high": 0.8}}]}"#;
-    let files: [(&str, Vec<u8>); 13] = [
+    // A 4 × 4 grey PFM (little-endian), a reference of the wrong size.
+    let mut pfm = b"Pf\n4 4\n-1.0\n".to_vec();
+    pfm.extend((0..16).flat_map(|i| (i as f32 / 16.0).to_le_bytes()));
+    let files: [(&str, Vec<u8>); 14] = [
         (
             "three.csv",
             "set,x0,x1\n0,0.1,0.2\n0,0.6,0.7\n1,0.3,0.4\n1,0.8,0.9\n2,0.5,0.1\n2,0.0,0.6\n".into(),
         ),
         ("s.json", scene.into()),
         ("m.obj", "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n".into()),
+        ("r4.pfm", pfm),
         ("p.csv", points.into_bytes()),
         ("long-line.csv", vec![b'0'; (1 << 20) + 10]),
         ("bom.csv", "\u{feff}x0,x1\n0.1,0.2\n".into()),
