@@ -503,10 +503,15 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
             r#""shape": "obj", "file": "missing.obj""#.into(),
             "missing.obj",
         ),
+        (
+            r#""shape": "obj", "file": "folder.obj""#.into(),
+            "folder.obj is not a regular file",
+        ),
     ];
     for (name, text, _) in &files {
         std::fs::write(dir.join(name), text).unwrap();
     }
+    std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
     for (name, _, phrase) in &files {
         cases.push((format!(r#""shape": "obj", "file": "{name}""#), phrase));
     }

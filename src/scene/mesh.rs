@@ -43,9 +43,15 @@ pub fn object_triangles(
 /// The triangles of an OBJ file; the error says what a usable file is and
 /// what this one is not.
 pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
-    let bytes = std::fs::metadata(path)
-        .map_err(|e| format!("a readable Wavefront OBJ file ({}: {e})", path.display()))?
-        .len();
+    let meta = std::fs::metadata(path)
+        .map_err(|e| format!("a readable Wavefront OBJ file ({}: {e})", path.display()))?;
+    if !meta.is_file() {
+        return Err(format!(
+            "a readable Wavefront OBJ file ({} is not a regular file)",
+            path.display()
+        ));
+    }
+    let bytes = meta.len();
     crate::memory::check(
         &format!("the mesh {}", path.display()),
         Some(bytes as f64 * BYTES_PER_OBJ_BYTE),
