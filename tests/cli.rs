@@ -855,6 +855,24 @@ fn sizes_beyond_memory_are_refused_before_allocating() {
         cmd.output().unwrap()
     };
     for (args, limit, phrase) in [
+        // A lone light field in 4D is the slow full-shift loss: the note
+        // (printed before the memory refusal) points to the projection path.
+        (
+            vec![
+                "optimize",
+                "points",
+                "-d",
+                "4",
+                "-n",
+                "16",
+                "--target",
+                "defocus:c=0.5",
+                "-o",
+                "x.csv",
+            ],
+            Some("1"),
+            "give it as a projection target: --target 'defocus:c=0.5;'",
+        ),
         (
             vec![
                 "predict",

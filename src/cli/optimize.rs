@@ -207,6 +207,20 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         );
     }
     let projections = a.dim == 4 && varspec::optimize::projections::is_projection_target(&a.target);
+    if a.dim == 4
+        && !projections
+        && varspec::integrands::parse(&a.target)
+            .ok()
+            .and_then(|f| f.light_field().map(|l| l.layer_shears().len() == 1))
+            .unwrap_or(false)
+    {
+        eprintln!(
+            "note: --target {t} alone descends the fully shifted estimator's 4D loss on a small \
+             box; for the (x, y)-shifted variance sheared sets are judged by, give it as a \
+             projection target: --target '{t};' (or with xy:/uv: terms), faster and blue",
+            t = a.target
+        );
+    }
     if a.checkpoint.is_some() && (a.domain == DomainArg::Square || projections) {
         bail!(
             "--checkpoint saves torus descents toward one target; {} designs do not take it",
