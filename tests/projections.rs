@@ -137,3 +137,33 @@ fn bad_projection_targets_are_refused() {
     assert!(parse_projections("-1*xy:family:disks", 64).is_err());
     assert!(parse_projections("xy:family:cubes", 64).is_err());
 }
+
+/// The report of a 4D projection design counts each set's iterations (as
+/// the torus report does) beside the cap; it used to give the cap alone.
+#[test]
+fn the_projection_report_counts_each_sets_iterations() {
+    let dir = crate::common::temp_dir("projection-report");
+    let report = dir.join("r.json");
+    crate::common::varspec_ok(&[
+        "optimize",
+        "points",
+        "-d",
+        "4",
+        "-n",
+        "16",
+        "--sets",
+        "2",
+        "--iters",
+        "7",
+        "--target",
+        "xy:family:disks;defocus:c=0.4",
+        "-o",
+        dir.join("d.csv").to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let r = crate::common::read_json(&report);
+    assert_eq!(r["iterations"], serde_json::json!([7, 7]), "{r}");
+    assert_eq!(r["max_iterations"], 7);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -68,8 +68,11 @@ pub struct ProjectionDesign {
     /// Domain, target, sizes, seed, start and wall time.
     #[serde(flatten)]
     pub run: DesignRun,
-    /// The iteration cap.
-    pub iterations: usize,
+    /// Per set: entries of its loss curve (what the descent ran before
+    /// it stopped).
+    pub iterations: Vec<usize>,
+    /// The iteration cap (`--iters`).
+    pub max_iterations: usize,
     /// Why each set's descent stopped (converged, accuracy floor or cap).
     pub stopped: Vec<Stop>,
     /// Per term, before and after.
@@ -155,7 +158,8 @@ pub fn design_projections(
             init: init_name,
             seconds,
         },
-        iterations: options.iters,
+        iterations: results.iter().map(|x| x.1.losses.len()).collect(),
+        max_iterations: options.iters,
         stopped: results.iter().map(|x| x.1.stop).collect(),
         terms: terms_out,
         closest_pair_over_hexagonal: closest_pairs,

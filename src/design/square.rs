@@ -68,8 +68,11 @@ pub struct SquareDesign {
     pub run: DesignRun,
     /// The estimator scored.
     pub estimator: &'static str,
-    /// The iteration cap.
-    pub iterations: usize,
+    /// Per set: entries of its loss curve (what the descent ran before
+    /// it stopped).
+    pub iterations: Vec<usize>,
+    /// The iteration cap (`--iters`).
+    pub max_iterations: usize,
     /// Why each set's descent stopped (converged, accuracy floor or cap).
     pub stopped: Vec<Stop>,
     /// What the loss is.
@@ -185,7 +188,8 @@ pub fn design_on_square(
             seconds,
         },
         estimator: "unshifted: mean of f over the set on [0,1)^2",
-        iterations: options.iters,
+        iterations: results.iter().map(|x| x.losses.len()).collect(),
+        max_iterations: options.iters,
         stopped: results.iter().map(|x| x.stop).collect(),
         loss: "sum of w_t MSE_t / MSE_t(start) (blue: repulsion / its value for uniform points); stochastic per iteration",
         score_start: results.iter().map(|x| x.start_score).collect(),

@@ -832,7 +832,7 @@ impl FigureExperiment {
                      closest pair over the hexagonal spacing: XY {:.2}, UV {:.2}.\n\n{terms}",
                     planes.join(","),
                     planes.join(", "),
-                    design.iterations,
+                    design.max_iterations,
                     design.closest_pair_over_hexagonal.xy,
                     design.closest_pair_over_hexagonal.uv
                 ))
