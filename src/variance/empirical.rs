@@ -1,10 +1,12 @@
 //! The empirical predictor: R independent realizations (fresh sampler
 //! randomness and a fresh uniform shift each) of Î, their unbiased sample
-//! variance by two passes with compensated sums, and a 95% confidence
-//! interval from the asymptotic variance of the sample variance,
-//! Var(s²) ≈ (m₄ − s⁴(R−3)/(R−1))/R with m₄ the fourth central moment —
-//! which accounts for the kurtosis of Î (indicator integrands are far from
-//! normal, where the χ² interval would be badly off).
+//! variance by two passes with compensated sums, its standard error from
+//! the asymptotic variance of the sample variance,
+//! Var(s²) ≈ (m₄ − s⁴(R−3)/(R−1))/R with m₄ the fourth central moment, and
+//! a 95% confidence interval by Bonett's log-scale form with the same
+//! kurtosis ([`bonett_interval`]) — both account for the kurtosis of Î
+//! (indicator integrands are far from normal, where the χ² interval would
+//! be badly off).
 
 use rayon::prelude::*;
 
@@ -152,21 +154,50 @@ where
     let variance = m2 / (r - 1.0);
     let var_of_var = crate::sum::variance_of_sample_variance(m4, variance, realizations);
     let half_width = NORMAL_95 * var_of_var.sqrt();
-    // Every realization gave the same estimate (an integrand whose support
-    // no point met, say): the data bound nothing above 0.
-    let ci_high = if m2 > 0.0 {
-        variance + half_width
+    let (ci_low, ci_high) = if m2 > 0.0 {
+        bonett_interval(&values, variance, NORMAL_95)
+            .unwrap_or(((variance - half_width).max(0.0), variance + half_width))
     } else {
-        f64::INFINITY
+        // Every realization gave the same estimate (an integrand whose
+        // support no point met, say): the data bound nothing above 0.
+        (0.0, f64::INFINITY)
     };
     Ok(EmpiricalEstimate {
         variance,
         stderr: var_of_var.sqrt(),
-        ci_low: (variance - half_width).max(0.0),
+        ci_low,
         ci_high,
         mean,
         realizations,
     })
+}
+
+/// Bonett's (2006, Computational Statistics & Data Analysis 50, 775–782)
+/// interval for a variance from non-normal values: on the log scale,
+/// ln(c·s²) ± z·c·√((γ̂ − (R − 3)/R)/(R − 1)), c = R/(R − z), with the
+/// kurtosis γ̂ = R·Σ(v − m)⁴/(Σ(v − v̄)²)² about a mean m trimmed by
+/// 1/(2√(R − 4)) in each tail. A symmetric interval s² ± z·√Var(s²) is too
+/// short above where few realizations carry the variance (a half-plane most
+/// sets straddle the same way: 175 of 200 seeds covered at R = 500); the
+/// log scale lifts the upper end. None below 8 realizations.
+fn bonett_interval(values: &[f64], s2: f64, z: f64) -> Option<(f64, f64)> {
+    let n = values.len();
+    if n < 8 || s2 <= 0.0 {
+        return None;
+    }
+    let r = n as f64;
+    let trimmed = ((r / (2.0 * (r - 4.0).sqrt())).floor() as usize).min((n - 1) / 2);
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let kept = &sorted[trimmed..n - trimmed];
+    let m = sum(kept.iter().copied()) / kept.len() as f64;
+    let s4 = sum(values.iter().map(|v| (v - m).powi(4)));
+    let ss = s2 * (r - 1.0);
+    let kurtosis = r * s4 / (ss * ss);
+    let c = r / (r - z);
+    let se = c * ((kurtosis - (r - 3.0) / r).max(0.0) / (r - 1.0)).sqrt();
+    let centre = (c * s2).ln();
+    Some(((centre - z * se).exp(), (centre + z * se).exp()))
 }
 
 #[cfg(test)]
