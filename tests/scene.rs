@@ -369,6 +369,31 @@ fn a_scene_in_millimetres_renders_as_in_metres() {
     }
 }
 
+/// A distant light (a sun 1e5 away) keeps the shadow of an occluder half
+/// a unit above the floor: the shadow ray's offset follows the rounding at
+/// its start, not the light's distance (a first version scaled it by the
+/// light's coordinates too, 0.76 here, and the umbra vanished).
+#[test]
+fn a_distant_light_keeps_nearby_shadows() {
+    use varspec::scene::analysis::SampleShear;
+    use varspec::scene::render::render;
+    let text = r#"{"camera": {"resolution": [16, 16], "fov_degrees": 30, "position": [0, 0, 0],
+      "look_at": [0, 0, -1], "focal_distance": 4, "aperture": 0},
+     "integrand": "light", "ambient": 0.0,
+     "objects": [
+      {"shape": "quad", "scale": [3, 3, 1], "translate": [0, 0, -5], "material": {"texture": "constant", "albedo": 0.5}},
+      {"shape": "quad", "scale": [0.5, 0.5, 1], "translate": [0, 0, -4.5], "material": {"texture": "constant", "albedo": 0.5}}
+     ],
+     "lights": [{"shape": "square", "centre": [1e5, 0, 1e5], "normal": [-1, 0, -1], "size": 1000, "radiance": 1e4}]}"#;
+    let scene = Scene::from_text(text, "sun").unwrap();
+    let sampler = registry::build("random", 16, Some(4), &[]).unwrap();
+    let image = render(&scene, sampler.as_ref(), &[SampleShear::NONE; 256], 1, 0).unwrap();
+    // Row 7: lit floor, the umbra the occluder casts on it, the occluder.
+    let row = &image.pixels[7 * 16..8 * 16];
+    assert!(row[0] > 0.01, "{row:?}");
+    assert!(row[2] == 0.0 && row[3] == 0.0, "the umbra is lit: {row:?}");
+}
+
 /// Directions are directions at any length: an `up` of 1e-200 or 1e200 and
 /// a light normal of 1e-10 render exactly as unit ones (they underflowed
 /// to a blank image, overflowed to a degenerate one, or were refused).

@@ -141,6 +141,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let shift = a
         .shift
         .unwrap_or(if pixel { ShiftArg::None } else { ShiftArg::All });
+    // Unshifted by default, a pixel's file sets count once each: the
+    // default realization count becomes the file's set count.
+    let realizations = if a.shift.is_none() && pixel && a.source.file().is_some() {
+        a.realizations.min(sets)
+    } else {
+        a.realizations
+    };
     if shift != ShiftArg::All {
         if !(a.method == MethodArg::Empirical || pixel) {
             bail!(
@@ -154,16 +161,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         if shift == ShiftArg::None && a.source.file().is_some() && sets < 2 {
             bail!(
-                "--shift none: the file holds one set, so one estimate and no variance without a \
-                 shift; give a file of 2 or more sets"
+                "--shift none (the default for a scene pixel, as its render): the file holds one \
+                 set, so one estimate and no variance without a shift; give a file of 2 or more \
+                 sets, or --shift all"
             );
         }
-        if shift == ShiftArg::None && a.source.file().is_some() && a.realizations > sets {
+        if shift == ShiftArg::None && a.source.file().is_some() && realizations > sets {
             bail!(
                 "--shift none --realizations {}: without a shift the file's {sets} set(s) give \
                  only {sets} distinct estimates, so repeating them would overstate the \
                  precision: pass --realizations {sets} or fewer",
-                a.realizations
+                realizations
             );
         }
     }
@@ -245,7 +253,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let shifted = shift.dims(f.dim());
         let e = empirical_shifting(
             f.as_ref(),
-            a.realizations,
+            realizations,
             DEFAULT_SHIFT_SEED,
             &shifted,
             |r| source.get_cyclic(r).map_err(|e| realization_error(r, e)),
@@ -265,7 +273,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // A sampler's sets are those the Fourier and spatial forms pass over;
     // the empirical predictor alone draws its own realizations.
     let drawn_label = if drawn.is_empty() && a.source.file().is_none() {
-        format!("{} realizations", a.realizations)
+        format!("{realizations} realizations")
     } else {
         format!("{sets} sets")
     };

@@ -153,10 +153,12 @@ const RAY_EPSILON: f64 = 1e-4;
 /// scaled by 1000 rendered its lit pixels 4–9% too dark).
 const RAY_EPSILON_ULPS: f64 = 64.0;
 
-/// The offset of a shadow ray between `point` and `at`, whose position came
-/// from a camera ray of reach `reach` (|origin|∞ + t).
-fn ray_offset(point: [f64; 3], at: [f64; 3], reach: f64) -> f64 {
-    let scale = point.iter().chain(&at).fold(reach, |m, c| m.max(c.abs()));
+/// The offset of a shadow ray leaving `point`, whose position came from a
+/// camera ray of reach `reach` (|origin|∞ + t): the rounding is at the
+/// ray's start, whatever the light's distance (a light's coordinates in the
+/// scale would let a distant sun's shadow rays skip nearby occluders).
+fn ray_offset(point: [f64; 3], reach: f64) -> f64 {
+    let scale = point.iter().fold(reach, |m, c| m.max(c.abs()));
     RAY_EPSILON.max(RAY_EPSILON_ULPS * f64::from(f32::EPSILON) * scale)
 }
 
@@ -324,7 +326,7 @@ impl Scene {
         if cos_surface <= 0.0 || cos_light <= 0.0 {
             return 0.0;
         }
-        let eps = ray_offset(point, at, reach);
+        let eps = ray_offset(point, reach);
         let origin: [f64; 3] = std::array::from_fn(|k| point[k] + eps * normal[k]);
         if !self.geometry.unoccluded(origin, dir, eps, r - eps) {
             return 0.0;
