@@ -517,6 +517,13 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
             "v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\nf 1 1 2\n",
             "(all 2 faces of",
         ),
+        // Every vertex is within 1e9, but the scene's x scale of 1.5
+        // places one at 1.35e9.
+        (
+            "placed.obj",
+            "v 0 0 0\nv 9e8 0 0\nv 0 1 0\nf 1 2 3\n",
+            "objects[0].scale = [1.5, 1.0, 1.0]: a placement whose vertices",
+        ),
     ];
     let mut cases: Vec<(String, &str)> = vec![
         (r#""shape": "obj""#.into(), "objects[0].file"),

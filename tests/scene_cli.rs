@@ -142,6 +142,12 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
             "\"period\": 0",
             "objects[1].material.period = 0",
         ),
+        // A period of 1e-300 overflowed the cell index.
+        (
+            "\"period\": 0.25",
+            "\"period\": 1e-300",
+            "objects[1].material.period = 1e-300: a period from 1e-6 to 1e9",
+        ),
         (
             "\"high\": 0.85",
             "\"high\": 1.5",

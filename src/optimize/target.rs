@@ -64,6 +64,16 @@ impl Target {
         }
         match integrands::parse(spec) {
             Ok(_) => Ok(Target::Integrand(spec.to_string())),
+            Err(integrands::IntegrandError::Unknown { name, .. })
+                if name
+                    .split_once('*')
+                    .is_some_and(|(w, _)| w.trim().parse::<f64>().is_ok()) =>
+            {
+                Err(fail(format!(
+                    "`{name}`: a weight W* belongs to a term of a sum (--domain square: \
+                     `A+2*B`) or of a 4D projection target (`xy:A;2*uv:B`); a lone target takes none"
+                )))
+            }
             Err(integrands::IntegrandError::Unknown { name, known }) => Err(fail(format!(
                 "`{name}` is neither an integrand ({known}) nor family:disks, power:A or \
                  radial:FILE.csv"

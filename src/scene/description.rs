@@ -432,8 +432,13 @@ impl MaterialFile {
             MaterialFile::Constant { albedo: a } => albedo("albedo", a),
             MaterialFile::Checker { period, low, high }
             | MaterialFile::Stripes { period, low, high } => {
-                if !(period.is_finite() && period > 0.0) {
-                    return Err(("period", SpecValue(period).to_string(), "a positive period"));
+                if !(MIN_PERIOD..=MAX_LENGTH).contains(&period) {
+                    return Err((
+                        "period",
+                        SpecValue(period).to_string(),
+                        "a period from 1e-6 to 1e9 (cells are counted exactly only while \
+                         coordinate / period stays below 2^53)",
+                    ));
                 }
                 albedo("low", low)?;
                 albedo("high", high)
@@ -446,6 +451,11 @@ impl MaterialFile {
 /// intersects in f32, whose products of coordinates overflow near 1e19
 /// and whose rounding at 1e9 is already 64 units.
 pub const MAX_LENGTH: f64 = 1e9;
+/// The smallest texture period: a hit point's coordinate in its object's
+/// frame (at most about 3e9 once placed vertices are within
+/// [`MAX_LENGTH`]) over the period stays below 2^53, so the cell index is
+/// an exact integer (a period of 1e-300 used to overflow it).
+const MIN_PERIOD: f64 = 1e-6;
 /// The largest radiance (lights and ambient): sums of many samples stay
 /// far from overflow.
 pub const MAX_RADIANCE: f64 = 1e12;

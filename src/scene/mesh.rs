@@ -6,7 +6,8 @@
 use std::path::Path;
 
 use super::description::{MAX_LENGTH, ObjectFile, SceneError, cross, norm, sub};
-use super::geometry::{ModelTriangle, shape_triangles};
+use super::geometry::{ModelTriangle, Placement, shape_triangles};
+use crate::spec_params::SpecValue;
 
 /// An upper bound on the bytes a mesh takes per byte of its OBJ text: a
 /// face line of 8 bytes (`f 1 2 3`) becomes a 72-byte f64 triangle, tobj's
@@ -21,23 +22,45 @@ const BYTES_PER_OBJ_BYTE: f64 = 32.0;
 /// [`SceneError::Field`] on `objects[index].file`: unreadable, too large
 /// for memory, malformed, no faces (or only faces of zero area), a
 /// position that is not finite or beyond [`MAX_LENGTH`], or a face that
-/// refers to a missing vertex.
+/// refers to a missing vertex; on `objects[index].scale` when the placed
+/// vertices reach beyond [`MAX_LENGTH`] (an OBJ's 1e9 times a scale of 1e9).
 pub fn object_triangles(
     object: &ObjectFile,
     index: usize,
     source_name: &str,
     folder: &Path,
 ) -> Result<Vec<ModelTriangle>, SceneError> {
-    if let Some(triangles) = shape_triangles(object.shape, object.subdivisions) {
-        return Ok(triangles);
+    let triangles = match shape_triangles(object.shape, object.subdivisions) {
+        Some(triangles) => triangles,
+        None => {
+            let file = object.file.clone().unwrap_or_default();
+            read_obj(&folder.join(&file)).map_err(|expected| SceneError::Field {
+                source_name: source_name.into(),
+                field: format!("objects[{index}].file"),
+                value: file,
+                expected,
+            })?
+        }
+    };
+    let place = Placement::of(object);
+    let reach = triangles
+        .iter()
+        .flatten()
+        .flat_map(|&p| place.apply(p))
+        .fold(0.0_f64, |m, c| m.max(c.abs()));
+    if reach > MAX_LENGTH {
+        return Err(SceneError::Field {
+            source_name: source_name.into(),
+            field: format!("objects[{index}].scale"),
+            value: format!("{:?}", object.scale),
+            expected: format!(
+                "a placement whose vertices (scale × model + translate) stay within {MAX_LENGTH:e} \
+                 of the origin (the BVH intersects in f32); this object reaches {}",
+                SpecValue(reach)
+            ),
+        });
     }
-    let file = object.file.clone().unwrap_or_default();
-    read_obj(&folder.join(&file)).map_err(|expected| SceneError::Field {
-        source_name: source_name.into(),
-        field: format!("objects[{index}].file"),
-        value: file,
-        expected,
-    })
+    Ok(triangles)
 }
 
 /// The triangles of an OBJ file; the error says what a usable file is and
