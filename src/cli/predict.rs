@@ -7,6 +7,7 @@ use anyhow::{anyhow, bail};
 use clap::ValueEnum;
 use serde_json::{Value, json};
 
+use super::progress;
 use super::source::{SourceArgs, realization_error};
 use varspec::PointSet;
 use varspec::integrands::{self, Integrand};
@@ -208,7 +209,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
         let half = res.saturating_sub(1) / 2;
         let start = Instant::now();
-        let parts = fourier_parts(f.as_ref(), half, a.tol, sets, lend)?;
+        let bar = progress::bar(sets as u64, "Fourier form, sets");
+        let parts = fourier_parts(f.as_ref(), half, a.tol, sets, |r| {
+            bar.inc(1);
+            lend(r)
+        })?;
+        bar.finish_and_clear();
         let seconds = start.elapsed().as_secs_f64();
         if wants(MethodArg::Radial) {
             let r = radial_from(&parts);
@@ -235,7 +241,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if wants(MethodArg::Spatial) {
         let start = Instant::now();
-        let value = match spatial(f.as_ref(), sets, lend) {
+        let bar = progress::bar(sets as u64, "spatial form, sets");
+        // The spatial form takes its sets in order: set r starts when r are done.
+        let spatial = spatial(f.as_ref(), sets, |r| {
+            bar.set_position(r as u64);
+            lend(r)
+        });
+        bar.finish_and_clear();
+        let value = match spatial {
             Ok(e) => json!({
                 "variance": e.variance, "stderr": known_stderr(e.stderr, e.sets),
                 "rounding_bound": e.rounding_bound,
