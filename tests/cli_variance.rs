@@ -225,6 +225,22 @@ fn converge_json_reports_slope_and_interval() {
     assert!(v["adjusted_n"][0].as_str().unwrap().contains("60 -> 64"));
 }
 
+/// The theory table's rates are for default parameters: CMJ with a fixed
+/// column count (strata 1/4 wide at every N) has none, however the
+/// parameter is spelled, while the default CMJ has jitter's N^-1.5.
+#[test]
+fn converge_theory_does_not_depend_on_how_parameters_are_spelled() {
+    let theory = |sampler: &[&str]| {
+        let mut args = vec!["converge", "--n", "64,256", "--sets", "2", "--json"];
+        args.extend_from_slice(&["--integrand", "disk:r=0.3"]);
+        args.extend_from_slice(sampler);
+        json(&args)["theory"].clone()
+    };
+    assert_eq!(theory(&["--sampler", "cmj"]).as_f64(), Some(-1.5));
+    assert!(theory(&["--sampler", "cmj:m=4"]).is_null());
+    assert!(theory(&["--sampler", "cmj", "--param", "m=4"]).is_null());
+}
+
 /// `converge --points`: files written by `sample` give exactly the
 /// variances of the sampler they came from (same seed, same sets), and
 /// the fit names no theory; a file per N is required.

@@ -130,7 +130,9 @@ pub fn fit_slope(ns: &[f64], vars: &[f64]) -> Result<SlopeFit, SlopeError> {
 
 /// The theoretical variance rate (exponent of N) of `sampler` on an
 /// integrand of class `class` in `dim` dimensions, where the theory table
-/// gives one: an asymptotic rate, which fits over a finite range of N can
+/// gives one. `sampler` is a registry name with its default parameters; a
+/// spec with parameters (`cmj:m=4`: a fixed column count, not strata near
+/// 1/√N on each side) has none. The rate is an asymptotic one, which fits over a finite range of N can
 /// miss by sub-leading terms (results/rates). CMJ on smooth integrands has
 /// none: its correlated strata are not jitter's independent ones, and it
 /// measures N^−3.03 on a Gaussian (results/rates), beyond jitter's N^−2.
