@@ -143,18 +143,22 @@ fn a_rerun_keeps_the_notes_written_by_hand_below_the_marker() {
     };
     run();
     let first = std::fs::read_to_string(out.join("README.md")).unwrap();
-    let notes = format!(
-        "{}\n\n## Why\n\nBecause.\n",
-        varspec::experiment::KEPT_NOTES
+    let marker = varspec::experiment::KEPT_NOTES;
+    // The run writes the marker, last, so a reader sees where notes go.
+    assert!(
+        first.ends_with(&format!("\n\n{marker}\n")),
+        "the README does not end with the notes marker: {first}"
     );
+    let tables = first[..first.find(marker).unwrap()].trim_end();
+    let notes = format!("{marker}\n\n## Why\n\nBecause.\n");
     std::fs::write(
         out.join("README.md"),
-        format!("{first}\nA stale line above the marker.\n\n{notes}"),
+        format!("{tables}\nA stale line above the marker.\n\n{notes}"),
     )
     .unwrap();
     run();
     let second = std::fs::read_to_string(out.join("README.md")).unwrap();
-    assert_eq!(second, format!("{}\n\n{notes}", first.trim_end()));
+    assert_eq!(second, format!("{tables}\n\n{notes}"));
     // A sharded run keeps them too: a shard run cuts the README down to
     // the notes and the merge puts the tables back above them.
     for shard in ["0/2", "1/2"] {

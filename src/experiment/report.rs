@@ -290,14 +290,16 @@ pub fn write_results(
 pub const KEPT_NOTES: &str =
     "<!-- Notes below this line are written by hand; a new run of the experiment keeps them. -->";
 
-/// `md` followed by the hand-written notes of the README now in `out`
-/// (from its [`KEPT_NOTES`] line on), if it has any.
+/// `md` followed by the [`KEPT_NOTES`] line and the hand-written notes
+/// below it in the README now in `out` (the line alone if there is none,
+/// so a reader sees where notes go).
 pub(super) fn with_kept_notes(out: &Path, md: String) -> String {
     let old = std::fs::read_to_string(out.join("README.md")).unwrap_or_default();
-    match old.find(KEPT_NOTES) {
-        Some(at) => format!("{}\n\n{}", md.trim_end(), &old[at..]),
-        None => md,
-    }
+    let notes = match old.find(KEPT_NOTES) {
+        Some(at) => old[at..].to_owned(),
+        None => format!("{KEPT_NOTES}\n"),
+    };
+    format!("{}\n\n{notes}", md.trim_end())
 }
 
 /// An experiment shard's file name before its `i-of-n.json`
@@ -309,7 +311,8 @@ pub const SHARD_PREFIX: &str = "shard-";
 /// (`shard` None) removes every `shard-*-of-*.json`; a shard run of a
 /// split into n removes the tables (variances.csv, slopes.csv, …: `merge`
 /// writes them again) and shards of other splits, and cuts README.md down
-/// to its hand-written notes ([`KEPT_NOTES`]; removed if it has none), so
+/// to its hand-written notes ([`KEPT_NOTES`]; removed if there are none
+/// below the line), so
 /// the merge keeps them. Other files are left alone.
 ///
 /// # Errors
@@ -337,7 +340,8 @@ pub fn remove_other_runs(out: &Path, shard: Option<Shard>) -> Result<(), Experim
         let notes = (name == "README.md")
             .then(|| std::fs::read_to_string(entry.path()).ok())
             .flatten()
-            .and_then(|old| old.find(KEPT_NOTES).map(|at| old[at..].to_owned()));
+            .and_then(|old| old.find(KEPT_NOTES).map(|at| old[at..].to_owned()))
+            .filter(|notes| notes.trim_end() != KEPT_NOTES);
         match notes {
             Some(notes) => write_atomic(&entry.path(), |w| w.write_all(notes.as_bytes()))
                 .map_err(|err| err.to_string()),
