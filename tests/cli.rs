@@ -564,6 +564,22 @@ fn compare_writes_a_table_and_pictures() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The report's integrand and pixel are checked before any work: a bad
+/// one fails at once, naming the option, and leaves no folder (it used to
+/// run two sections, 17 s, then fail with an empty folder left behind).
+#[test]
+fn a_bad_report_option_fails_before_any_work_and_leaves_no_folder() {
+    let dir = std::env::temp_dir().join(format!("varspec-badreport-{}", std::process::id()));
+    let out = dir.join("rep");
+    let o = out.to_str().unwrap();
+    common::assert_fails(&["report", "-o", o, "--pixel", "disk:r=0.3"], "--pixel");
+    common::assert_fails(
+        &["report", "-o", o, "--integrand", "defocus:c=0.5"],
+        "--integrand",
+    );
+    assert!(!out.exists(), "a failed report left {}", out.display());
+}
+
 #[test]
 fn the_main_job_writes_a_self_contained_report() {
     let dir = std::env::temp_dir().join(format!("varspec-report-{}", std::process::id()));

@@ -307,6 +307,33 @@ pub struct Tour {
     pub seconds: f64,
 }
 
+impl TourOptions {
+    /// The integrand is a 2D one (the sampler comparison) and the pixel a
+    /// light field (the shear search), checked before any work is done or
+    /// any folder made.
+    ///
+    /// # Errors
+    /// [`TourError`] naming the option and what it must be.
+    pub fn check(&self) -> Result<(), TourError> {
+        let f = integrands::parse(&self.integrand).map_err(at("the integrand (--integrand)"))?;
+        if f.dim() != 2 {
+            return Err(at("the integrand (--integrand)")(format!(
+                "`{}` is {}D; the sampler comparison takes a 2D integrand",
+                self.integrand,
+                f.dim()
+            )));
+        }
+        let pixel = integrands::parse(&self.pixel).map_err(at("the pixel (--pixel)"))?;
+        if pixel.light_field().is_none() {
+            return Err(at("the pixel (--pixel)")(format!(
+                "`{}` is not a light field; the shear search takes defocus:… or layers:…",
+                self.pixel
+            )));
+        }
+        Ok(())
+    }
+}
+
 fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Result<Vec<PointSet>, TourError> {
     crate::samplers::generate_sets(sampler, seed, sets, &|| {}).map_err(at("drawing sets"))
 }
@@ -318,6 +345,7 @@ fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Result<Vec<PointSet>, 
 /// [`TourError`] naming the step that failed.
 pub fn run_tour(options: &TourOptions, progress: &dyn Fn(&str)) -> Result<Tour, TourError> {
     let clock = Instant::now();
+    options.check()?;
     std::fs::create_dir_all(&options.folder).map_err(at("creating the report folder"))?;
     progress("samplers and predictors");
     let predict = predict_section(options)?;
