@@ -36,6 +36,7 @@ pub fn write_results(
                 c.stderr.map_or(String::new(), |s| format!("{s:e}")),
                 c.method.clone(),
                 e.sets.to_string(),
+                crate::rng::level_seed(e.seed, c.n).to_string(),
             ]
         })
         .collect();
@@ -50,6 +51,7 @@ pub fn write_results(
             "stderr",
             "method",
             "sets",
+            "seed",
         ],
         &rows,
         &fail,
@@ -100,7 +102,8 @@ pub fn write_results(
     );
     md += &format!(
         "Sampler-level predictions of the shift-randomized estimator's variance, mean over {} realizations \
-         (seed {}) ± standard error; spatial form unless marked (F: Fourier form).\n\n",
+         (seed {}; each N draws its own stream, `variances.csv`'s `seed` column) ± standard error; \
+         spatial form unless marked (F: Fourier form).\n\n",
         e.sets, e.seed
     );
     let header: Vec<String> = functions

@@ -183,7 +183,9 @@ pub fn run_items(
             let (s, n) = registry::build_nearest(sampler, requested, Some(dim), &[])
                 .map_err(|err| fail("-", err.to_string()))?;
             // Realizations drawn once per item and shared by every integrand.
-            let sets = samplers::generate_sets(s.as_ref(), e.seed, e.sets, &|| {})
+            // Each N its own stream, so the levels of a slope are independent.
+            let seed = crate::rng::level_seed(e.seed, n);
+            let sets = samplers::generate_sets(s.as_ref(), seed, e.sets, &|| {})
                 .map_err(|err| fail("-", err.to_string()))?;
             for (fi, f) in functions.iter().enumerate() {
                 let p = sampler_variance(f.as_ref(), e.sets, VarianceForm::Auto, |r| {
