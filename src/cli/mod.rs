@@ -56,7 +56,7 @@ enum Command {
     /// The main job: the design loop end to end on built-in defaults, as one
     /// self-contained HTML page (out/report/index.html) with its data.
     Report(report::Args),
-    /// Generate point sets with a sampler and write them as CSV or UTK text.
+    /// Generate point sets with a sampler and write them as CSV, UTK text or NumPy .npy.
     Sample(sample::Args),
     /// Draw pictures (PNG) of point sets.
     #[command(subcommand)]

@@ -17,7 +17,7 @@ pub enum PlotCommand {
 
 #[derive(clap::Args)]
 pub struct PointsArgs {
-    /// Point-set file (CSV or UTK text).
+    /// Point-set file (CSV, UTK text or .npy).
     file: PathBuf,
     /// The two dimensions to draw, horizontal then vertical (XU = 0,2; YV = 1,3).
     #[arg(long, default_value = "0,1")]
