@@ -77,6 +77,12 @@ impl DrawArgs {
         self.seed_given.unwrap_or(0)
     }
 
+    /// Whether --seed was given (a command where it would do nothing
+    /// refuses it).
+    pub fn seed_was_given(&self) -> bool {
+        self.seed_given.is_some()
+    }
+
     /// Realizations to draw: --sets, default [`DEFAULT_SETS`].
     pub fn sets(&self) -> usize {
         self.sets_given.unwrap_or(DEFAULT_SETS)

@@ -149,6 +149,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         MethodArg::Fourier
     });
+    if a.res.is_some() && method == MethodArg::Spatial {
+        bail!("--res sets the Fourier form's box: it applies to --method fourier");
+    }
+    if !a.points.is_empty() && a.family.is_none() && a.draw.seed_was_given() {
+        bail!(
+            "--seed with --points draws only --family members; the files are the sets, and \
+             --integrand has no members"
+        );
+    }
     let bar = progress::bar(levels.len() as u64, "converge");
     let mut points = Vec::new();
     for level in &levels {

@@ -98,13 +98,13 @@ pub struct PointsArgs {
     #[arg(long, visible_alias = "sampler")]
     init: Option<String>,
     /// Square: family members the result and the classic samplers are scored
-    /// on (at least 2, for the standard error).
-    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long, default_value_t = 1024)]
-    members: usize,
+    /// on (at least 2, for the standard error) [default: 1024].
+    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
+    members: Option<usize>,
     /// Square: seed of the scoring members (the descent draws its own members
-    /// from --seed on other streams).
-    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 1)]
-    score_seed: u64,
+    /// from --seed on other streams) [default: 1].
+    #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long)]
+    score_seed: Option<u64>,
     /// Frequency box |k| < K/2 of the loss, as in spectrum and predict
     /// (default K = 2h + 1 with h = 2.5·N^(1/d) within [16, 400] for families
     /// and power laws, 8·N^(1/d) within [32, 256] for integrands).
@@ -268,6 +268,12 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     }
     if a.domain == DomainArg::Square {
         return points_square(a);
+    }
+    if a.members.is_some() || a.score_seed.is_some() {
+        bail!(
+            "--members and --score-seed choose the family members --domain square designs are \
+             scored on; a torus design is scored by its target's loss"
+        );
     }
     if projections {
         return points_projections(a);
@@ -510,6 +516,11 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The family members a square design is scored on without --members.
+const DEFAULT_SCORE_MEMBERS: usize = 1024;
+/// The seed of those members without --score-seed.
+const DEFAULT_SCORE_SEED: u64 = 1;
+
 /// `optimize points --domain square`: descend on family MSEs of the
 /// unshifted estimator, then score the result and the classic samplers on
 /// family members the descent never saw.
@@ -518,6 +529,10 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     if a.dim != 2 {
         bail!("the square holds 2D point sets (got -d {})", a.dim);
     }
+    let (members, score_seed) = (
+        a.members.unwrap_or(DEFAULT_SCORE_MEMBERS),
+        a.score_seed.unwrap_or(DEFAULT_SCORE_SEED),
+    );
     let request = SquareRequest {
         n: a.n,
         target: a.target.clone(),
@@ -525,8 +540,8 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
         iters: a.iters,
         seed: a.seed,
         init: a.init.clone(),
-        members: a.members,
-        score_seed: a.score_seed,
+        members,
+        score_seed,
     };
     let iters = a
         .iters
@@ -544,8 +559,8 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
         design.run.seconds,
         design.run.init,
         design.stopped[0].describe(),
-        a.members,
-        a.score_seed
+        members,
+        score_seed
     );
     for (name, v) in &design.comparison {
         let mses: String = design

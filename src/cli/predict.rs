@@ -85,9 +85,11 @@ pub struct Args {
     /// Which predictor(s) to run.
     #[arg(long, value_enum, default_value_t = MethodArg::All)]
     method: MethodArg,
-    /// Realizations (fresh sampler randomness and shift each) of the empirical predictor.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 10_000)]
-    realizations: usize,
+    /// Realizations (fresh sampler randomness and shift each) of the
+    /// empirical predictor [default: 10000; a scene pixel's point file:
+    /// its set count].
+    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
+    realizations: Option<usize>,
     /// Which dimensions the empirical predictor's random shift moves: all
     /// (the estimator of every predictor), xy (dimensions 0 and 1: how
     /// sheared 4D sets, e.g. from `optimize shear -o`, are judged) or none
@@ -98,13 +100,16 @@ pub struct Args {
     /// Fourier box |k| < K/2 (default 256 in 2D, 16 in 4D).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
-    /// NUFFT tolerance of the Fourier predictor's spectrum.
-    #[arg(long, default_value_t = 1e-10, value_parser = super::args::tolerance)]
-    tol: f64,
+    /// NUFFT tolerance of the Fourier predictor's spectrum [default: 1e-10].
+    #[arg(long, value_parser = super::args::tolerance)]
+    tol: Option<f64>,
     /// Print one JSON object (the scripting interface).
     #[arg(long)]
     json: bool,
 }
+
+/// The empirical predictor's realizations without --realizations.
+const DEFAULT_REALIZATIONS: usize = 10_000;
 
 /// A standard error over `sets` realizations: unknown (JSON null) from one.
 fn known_stderr(stderr: f64, sets: usize) -> Option<f64> {
@@ -130,6 +135,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         integrands::parse(spec)?
     };
+    // Options of a predictor that will not run are refused, not ignored.
+    let fourier_runs = !pixel
+        && matches!(
+            a.method,
+            MethodArg::Fourier | MethodArg::Radial | MethodArg::All
+        );
+    for (given, option) in [(a.res.is_some(), "--res"), (a.tol.is_some(), "--tol")] {
+        if given && !fourier_runs {
+            bail!(
+                "{option} sets the Fourier box's transform: it applies to --method fourier, \
+                 radial or all{}",
+                if pixel {
+                    " (not to a scene pixel, which only the empirical predictor takes)"
+                } else {
+                    ""
+                }
+            );
+        }
+    }
+    if a.realizations.is_some() && !matches!(a.method, MethodArg::Empirical | MethodArg::All) {
+        bail!("--realizations applies to the empirical predictor (--method empirical or all)");
+    }
     if let Some(res) = a.res.filter(|&r| r < 3) {
         bail!(
             "--res {res}: the Fourier box |k| < K/2 needs K >= 3 (K = 3 is the 3^d box around DC)"
@@ -144,10 +171,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .unwrap_or(if pixel { ShiftArg::None } else { ShiftArg::All });
     // Unshifted by default, a pixel's file sets count once each: the
     // default realization count becomes the file's set count.
-    let realizations = if a.shift.is_none() && pixel && a.source.file().is_some() {
-        a.realizations.min(sets)
-    } else {
-        a.realizations
+    let realizations = match a.realizations {
+        Some(r) => r,
+        None if a.shift.is_none() && pixel && a.source.file().is_some() => {
+            DEFAULT_REALIZATIONS.min(sets)
+        }
+        None => DEFAULT_REALIZATIONS,
     };
     if shift != ShiftArg::All {
         if !(a.method == MethodArg::Empirical || pixel) {
@@ -210,7 +239,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let half = res.saturating_sub(1) / 2;
         let start = Instant::now();
         let bar = progress::bar(sets as u64, "Fourier form, sets");
-        let parts = fourier_parts(f.as_ref(), half, a.tol, sets, |r| {
+        let parts = fourier_parts(f.as_ref(), half, a.tol.unwrap_or(1e-10), sets, |r| {
             bar.inc(1);
             lend(r)
         })?;
