@@ -127,6 +127,58 @@ fn names_that_leave_the_output_folder_are_refused() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A variance at or below the spatial form's rounding bound is reported as
+/// zero to rounding and left out of the slopes (a grid integrates
+/// cos(2πx) exactly: 2e-17 of noise used to be tabulated and fitted), and
+/// a standard error at rounding level (uniform jitter's sets all give one
+/// variance: shifting a lattice does not change it) reads as 0.
+#[test]
+fn variances_zero_to_rounding_are_reported_as_such_and_not_fitted() {
+    let dir = temp_dir("experiment-rounding");
+    let file = dir.join("e.json");
+    let out = dir.join("out");
+    std::fs::write(
+        &file,
+        r#"{"name": "rounding", "samplers": ["regular", "uniform-jitter"],
+            "integrands": ["cos:kx=1", "disk:r=0.3"], "n": [16, 64, 256], "sets": 4}"#,
+    )
+    .unwrap();
+    ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let md = std::fs::read_to_string(out.join("README.md")).unwrap();
+    let rows: Vec<&str> = md
+        .lines()
+        .filter(|l| l.starts_with("| regular |"))
+        .collect();
+    assert_eq!(rows.len(), 4, "three N and the slopes: {md}");
+    for row in &rows[..3] {
+        let cos = row.split(" | ").nth(1).unwrap();
+        assert!(cos.starts_with("0 to rounding (≤ "), "{row}");
+    }
+    assert!(
+        rows[3].contains("no slope: fewer than two distinct N, or a variance zero to rounding"),
+        "{}",
+        rows[3]
+    );
+    let uniform = md
+        .lines()
+        .find(|l| l.starts_with("| uniform-jitter |"))
+        .unwrap();
+    assert!(uniform.contains("± 0 to rounding"), "{uniform}");
+    let csv = std::fs::read_to_string(out.join("variances.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .ends_with(",sets,seed,rounding_bound")
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_rerun_keeps_the_notes_written_by_hand_below_the_marker() {
     let dir = temp_dir("experiment-notes");

@@ -37,6 +37,7 @@ pub fn write_results(
                 c.method.clone(),
                 e.sets.to_string(),
                 crate::rng::level_seed(e.seed, c.n).to_string(),
+                format!("{:e}", c.rounding_bound),
             ]
         })
         .collect();
@@ -52,6 +53,7 @@ pub fn write_results(
             "method",
             "sets",
             "seed",
+            "rounding_bound",
         ],
         &rows,
         &fail,
@@ -143,9 +145,18 @@ pub fn write_results(
                         } else {
                             String::new()
                         };
-                        let err = c
-                            .stderr
-                            .map_or("± unknown (1 set)".into(), |s| format!("± {s:.1e}"));
+                        if c.variance <= c.rounding_bound {
+                            return format!("0 to rounding (≤ {:.0e}){mark}{n}", c.rounding_bound);
+                        }
+                        // Sets that all give one variance (a lattice's is
+                        // the same at every offset) differ by rounding only.
+                        let err = c.stderr.map_or("± unknown (1 set)".into(), |s| {
+                            if s <= c.rounding_bound {
+                                "± 0 to rounding".into()
+                            } else {
+                                format!("± {s:.1e}")
+                            }
+                        });
                         format!("{:.4e} {err}{mark}{n}", c.variance)
                     })
             },
@@ -187,7 +198,12 @@ pub fn write_results(
                 .then(|| fit_slope(&ns, &vs).ok())
                 .flatten()
         };
-        let fit = |s: usize, i: usize| fit_of(s, i, &|c| Some(c.variance));
+        // A variance zero to rounding has no logarithm worth fitting.
+        let fit = |s: usize, i: usize| {
+            fit_of(s, i, &|c| {
+                (c.variance > c.rounding_bound).then_some(c.variance)
+            })
+        };
         let radial_fit = |s: usize, i: usize| fit_of(s, i, &|c| c.radial.map(|r| r.variance));
         let shown = |fit: Option<SlopeFit>| {
             fit.map(|f| {
@@ -205,7 +221,9 @@ pub fn write_results(
                     theoretical_rate(&e.samplers[s], functions[i].class(), functions[i].dim());
                 let th = theory.map_or(String::new(), |t| format!(" ({t})"));
                 match shown(fit(s, i)) {
-                    None => format!("no slope: fewer than two distinct N or a zero variance{th}"),
+                    None => format!(
+                        "no slope: fewer than two distinct N, or a variance zero to rounding{th}"
+                    ),
                     Some(f) => format!("{f}{th}"),
                 }
             },

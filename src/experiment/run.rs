@@ -33,6 +33,10 @@ pub struct Cell {
     pub variance: f64,
     /// Its standard error; `None` from a single set (unknown, not 0).
     pub stderr: Option<f64>,
+    /// The spatial form's bound on its rounding (0 for the Fourier form):
+    /// a variance at or below it is zero to rounding.
+    #[serde(default)]
+    pub rounding_bound: f64,
     /// `spatial` or `fourier`.
     pub method: String,
     /// The radial predictor on the same realizations, when the experiment
@@ -218,6 +222,7 @@ pub fn run_items(
                     n,
                     variance: p.variance,
                     stderr: (e.sets >= 2).then_some(p.stderr),
+                    rounding_bound: p.rounding_bound,
                     method: p.method.to_string(),
                     radial,
                 });
