@@ -124,7 +124,14 @@ pub fn hexagonal_spacing(n: usize) -> f64 {
 /// lattices: 1/N, √(2/(√3 N)), (√2/N)^(1/3), (2/N)^(1/4); None beyond
 /// four dimensions (at least one point).
 pub fn packing_radius(n: usize, dim: usize) -> Option<f64> {
-    let n = n.max(1) as f64;
+    packing_radius_at_density(n.max(1) as f64, dim)
+}
+
+/// [`packing_radius`] for a density λ (expected points per unit volume)
+/// rather than a count: a random-count process's spacing is its λ's, not
+/// one realization's count.
+pub fn packing_radius_at_density(density: f64, dim: usize) -> Option<f64> {
+    let n = density;
     match dim {
         1 => Some(1.0 / n),
         2 => Some((2.0 / (3f64.sqrt() * n)).sqrt()),

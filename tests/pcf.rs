@@ -74,3 +74,43 @@ fn bad_pcf_parameters_are_errors() {
     assert!(pair_correlation(std::slice::from_ref(&set), 0.1, 0, 0.01).is_err());
     assert!(pair_correlation(&[], 0.1, 10, 0.01).is_err());
 }
+
+/// Isotropic jitter has a random count: its radii come from the density
+/// λ = N, not from set 0's count, so every seed gives the same grid (r at
+/// r_rel = 2.5 is 2.5·√(2/(√3·1024)) = 0.0839514); seeds 0, 1, 2 used to
+/// give 0.083828, 0.084281, 0.084033 (their first sets hold 1027, 1016 and
+/// 1022 points).
+#[test]
+fn a_random_count_process_takes_its_radii_from_its_density() {
+    let radii = |seed: &str| -> Vec<f64> {
+        let out = crate::common::varspec_ok(&[
+            "pcf",
+            "--sampler",
+            "ijitter",
+            "-n",
+            "1024",
+            "--sets",
+            "4",
+            "--seed",
+            seed,
+            "--bins",
+            "4",
+        ]);
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').next().unwrap().parse().unwrap())
+            .collect()
+    };
+    let expected = 2.5 * (2.0 / (3f64.sqrt() * 1024.0)).sqrt();
+    for seed in ["0", "1", "2"] {
+        let r = radii(seed);
+        assert_eq!(r.len(), 4);
+        assert!(
+            (r[3] - expected).abs() < 1e-12,
+            "seed {seed}: r at r_rel = 2.5 is {} against {expected}",
+            r[3]
+        );
+    }
+}

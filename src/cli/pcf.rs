@@ -7,7 +7,7 @@ use anyhow::bail;
 use super::progress;
 use super::source::SourceArgs;
 use varspec::io::{write_atomic, write_csv_rows};
-use varspec::neighbours::packing_radius;
+use varspec::neighbours::packing_radius_at_density;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
 use varspec::spectrum::pcf::pair_correlation;
 
@@ -60,8 +60,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         })
         .collect::<Result<Vec<_>, _>>()?;
     bar.finish_and_clear();
+    // A random-count process's spacing is its density's, not set 0's count.
     let (n, d) = (sets[0].len(), sets[0].dim());
-    let Some(unit) = packing_radius(n, d) else {
+    let Some(unit) = packing_radius_at_density(sets[0].density().unwrap_or(n as f64), d) else {
         bail!("pair correlation covers 1 to 4 dimensions; the points are {d}-dimensional");
     };
     // The estimator needs (range + 6σ)·r_max < 1/2 (beyond, toroidal

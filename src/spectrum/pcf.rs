@@ -7,7 +7,8 @@
 //! with k_σ the normalized Gaussian of standard deviation σ (the bandwidth)
 //! and |∂B_r| the surface of the d-sphere of radius r (2πr in 2D): on the
 //! unit torus the expected pair count at distance r of a Poisson process is
-//! N(N−1)|∂B_r|dr, so ĝ ≡ 1 for white noise. Pairs are found with a cell
+//! N(N−1)|∂B_r|dr, so ĝ ≡ 1 for white noise. Sets of a random-count
+//! process (a density λ: isotropic jitter) use λ² for N(N−1). Pairs are found with a cell
 //! grid within r_end + 6σ, O(N·neighbours), not O(N²). Valid for
 //! r_end + 6σ < ½ (beyond, periodic images alias).
 
@@ -107,7 +108,10 @@ pub fn pair_correlation(
                     }
                 });
             }
-            let pairs = (n * (n - 1)) as f64;
+            // A random-count process (a density λ on the set) normalizes by
+            // λ²: its pair density at distance r is λ²·g(r) whatever the
+            // count's law. A fixed count uses its own N(N−1).
+            let pairs = set.density().map_or((n * (n - 1)) as f64, |l| l * l);
             acc.iter()
                 .zip(&r)
                 .map(|(a, &rb)| a / (pairs * unit_sphere_surface(d) * rb.powi(d as i32 - 1)))
