@@ -923,7 +923,7 @@ fn fitted_slope(cells: &[Cell], sampler: &str, integrand: &str) -> f64 {
     fit_slope(&x, &y).unwrap().slope
 }
 
-/// isotropic-jitter.json: isotropic jitter's variance is 1.46–1.64× jitter's
+/// isotropic-jitter.json: isotropic jitter's variance is 1.34–1.62× jitter's
 /// on the disk and on both squares at full size; here 64 and 256 points,
 /// 32 sets, the interval must lie inside (1, 2.5).
 #[test]

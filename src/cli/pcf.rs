@@ -107,7 +107,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if let Some(path) = &a.png {
         let plot = LinePlot {
-            title: format!("pair correlation: {} ({} sets)", source.name(), sets.len()),
+            title: format!(
+                "pair correlation: {} ({})",
+                source.name(),
+                super::stdout::counted(sets.len(), "set")
+            ),
             x_label: "r / r_max".into(),
             y_label: "g(r)".into(),
             log_log: false,

@@ -315,9 +315,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // A sampler's sets are those the Fourier and spatial forms pass over;
     // the empirical predictor alone draws its own realizations.
     let drawn_label = if drawn.is_empty() && a.source.file().is_none() {
-        format!("{realizations} realizations")
+        super::stdout::counted(realizations, "realization")
     } else {
-        format!("{sets} sets")
+        super::stdout::counted(sets, "set")
     };
     outln!(
         "{} on {} ({}, {drawn_label}), I {} {}",
@@ -418,11 +418,11 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
         return Ok(());
     }
     outln!(
-        "{} on {} ({}, {} sets), unshifted estimator on the square",
+        "{} on {} ({}, {}), unshifted estimator on the square",
         family.spec(),
         source.name(),
         source.count_label(),
-        sets.len()
+        super::stdout::counted(sets.len(), "set")
     );
     outln!(
         "  brute force  {:.6e}  95% CI [{:.4e}, {:.4e}] over {} members",

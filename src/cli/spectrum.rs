@@ -157,7 +157,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 &|| bar.inc(1),
             )?;
             bar.finish_and_clear();
-            let title = format!("{} ({} sets)", source.name(), spectrum.sets);
+            let title = format!(
+                "{} ({})",
+                source.name(),
+                super::stdout::counted(spectrum.sets, "set")
+            );
             (spectrum, title, "log10 power (N·P_S)")
         }
     };

@@ -92,3 +92,12 @@ macro_rules! outln {
         $crate::cli::stdout::line(format_args!($($arg)*))
     };
 }
+
+/// `n` and the noun, plural unless n = 1: "1 set", "16 sets".
+pub fn counted(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}

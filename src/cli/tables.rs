@@ -29,9 +29,10 @@ enum FormatArg {
 }
 
 #[derive(clap::Args)]
+#[command(group = clap::ArgGroup::new("table_source").required(true).args(["sampler", "from", "merge"]))]
 pub struct Args {
     /// Sampler to draw the table from.
-    #[arg(long, conflicts_with = "from", required_unless_present_any = ["from", "merge"])]
+    #[arg(long)]
     sampler: Option<String>,
     /// Point-set file to convert instead.
     #[arg(long)]
@@ -145,9 +146,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         })?;
     }
     outln!(
-        "wrote {} ({} sets of {} points in {}D)",
+        "wrote {} ({} of {} points in {}D)",
         a.output.display(),
-        sets.len(),
+        super::stdout::counted(sets.len(), "set"),
         meta.n,
         meta.dim
     );

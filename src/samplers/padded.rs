@@ -60,7 +60,7 @@ pub(crate) fn umj_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerErr
 pub(crate) fn padded_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let half = |key: &'static str| {
         let name = c.param(key);
-        if matches!(name, "padded" | "umj") {
+        if matches!(name.trim(), "" | "padded" | "umj") {
             return Err(c.bad_param(key, "a 2D sampler (see varspec sample --list)"));
         }
         c.build_other(name, c.n, Some(2), &[])

@@ -135,7 +135,7 @@ pub fn fit_slope(ns: &[f64], vars: &[f64]) -> Result<SlopeFit, SlopeError> {
 /// 1/√N on each side) has none. The rate is an asymptotic one, which fits over a finite range of N can
 /// miss by sub-leading terms (results/rates). CMJ on smooth integrands has
 /// none: its correlated strata are not jitter's independent ones, and it
-/// measures N^−3.03 on a Gaussian (results/rates), beyond jitter's N^−2.
+/// measures N^−3.06 on a Gaussian (results/rates), beyond jitter's N^−2.
 pub fn theoretical_rate(sampler: &str, class: IntegrandClass, dim: usize) -> Option<f64> {
     let d = dim as f64;
     let jitter = if class.smooth {
