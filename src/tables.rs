@@ -6,7 +6,7 @@
 pub mod shard;
 
 use crate::integrands;
-use crate::io::tables::{TableFormat, TableMetadata};
+use crate::io::tables::{TableFormat, TableMetadata, to_unit_f32};
 use crate::points::PointSet;
 use crate::registry;
 use crate::samplers::SamplerError;
@@ -104,7 +104,8 @@ pub fn optimized_for(
 }
 
 /// The metadata of a table of `sets` in `format`; the predicted variances
-/// (spatial form, mean over the sets) are computed for 2D sets when
+/// (spatial form, mean over the sets, of the values the format stores:
+/// f32 tables' truncated ones) are computed for 2D sets when
 /// `force_variance` or when they cost at most [`VARIANCE_BUDGET`] pair
 /// evaluations, and the second value says which.
 ///
@@ -132,6 +133,33 @@ pub fn metadata(
         PredictedVariances::Computed
     } else {
         PredictedVariances::OverBudget { pairs }
+    };
+    let single = matches!(format, TableFormat::F32 | TableFormat::CHeader);
+    // A single-precision table is predicted on the values it stores.
+    let stored: Vec<PointSet> = if single && status == PredictedVariances::Computed {
+        sets.iter()
+            .map(|s| {
+                let coords = s
+                    .coords()
+                    .iter()
+                    .map(|&x| f64::from(to_unit_f32(x)))
+                    .collect();
+                let stored =
+                    PointSet::new(dim, coords).expect("f32 values of [0, 1) points lie in [0, 1)");
+                match s.density() {
+                    Some(density) => stored.with_density(density),
+                    None => Ok(stored),
+                }
+            })
+            .collect::<Result<_, _>>()
+            .expect("the density was valid on the f64 set")
+    } else {
+        Vec::new()
+    };
+    let sets = if single && status == PredictedVariances::Computed {
+        &stored[..]
+    } else {
+        sets
     };
     let predicted_variance = if status == PredictedVariances::Computed {
         REFERENCE_INTEGRANDS

@@ -34,9 +34,10 @@ pub struct Args {
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs_beside([a.csv.as_deref(), a.png.as_deref()], [a.source.file()])?;
-    if !(a.range.is_finite() && a.range > 0.0) {
+    if !(a.range.is_finite() && a.range >= 1e-3) {
         bail!(
-            "--range {:?}: the largest radius, in units of the packing distance r_max, must be a positive number (default 2.5)",
+            "--range {:?}: the largest radius, in units of the packing distance r_max, must be a \
+             number of at least 0.001, the smallest --bandwidth (default 2.5)",
             a.range
         );
     }
