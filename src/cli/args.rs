@@ -149,6 +149,15 @@ pub fn check_outputs_beside<'a>(
         .collect();
     let mut seen: Vec<(&std::path::Path, std::path::PathBuf)> = Vec::new();
     for path in outputs.into_iter().flatten() {
+        // Pictures are PNG whatever the name: a .jpg name would hold PNG bytes.
+        if let Some(ext) = path.extension().map(|e| e.to_string_lossy().to_lowercase())
+            && ["jpg", "jpeg", "gif", "bmp", "tif", "tiff", "webp"].contains(&ext.as_str())
+        {
+            anyhow::bail!(
+                "{}: varspec writes pictures as PNG only; name the file .png",
+                path.display()
+            );
+        }
         varspec::io::check_output(path)?;
         if varspec::io::is_standard_output(path) {
             super::stdout::carries_data();

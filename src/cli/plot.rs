@@ -40,6 +40,7 @@ pub fn run(c: PlotCommand) -> anyhow::Result<()> {
 }
 
 fn points(a: PointsArgs) -> anyhow::Result<()> {
+    args::check_outputs_beside([Some(a.output.as_path())], [Some(a.file.as_path())])?;
     let dims = args::dims(&a.dims, 2)?;
     if !(16..=8192).contains(&a.size) {
         bail!("--size {}: choose 16 to 8192 pixels", a.size);
