@@ -179,6 +179,33 @@ fn variances_zero_to_rounding_are_reported_as_such_and_not_fitted() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Shards written before cells carried their rounding bound (and before
+/// each N drew its own seed) are refused with a reason, not merged into
+/// tables that would give their levels seeds they were not drawn with.
+#[test]
+fn shards_of_an_older_version_are_refused_not_merged() {
+    let dir = temp_dir("experiment-old-shards");
+    let file = dir.join("e.json");
+    let out = dir.join("out");
+    std::fs::write(&file, SMALL).unwrap();
+    for shard in ["0/2", "1/2"] {
+        run_shard(&file, shard, &out);
+    }
+    let shard = out.join("shard-0-of-2.json");
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&shard).unwrap()).unwrap();
+    for cell in v["cells"].as_array_mut().unwrap() {
+        cell.as_object_mut().unwrap().remove("rounding_bound").unwrap();
+    }
+    std::fs::write(&shard, v.to_string()).unwrap();
+    assert_fails(
+        &["merge", out.to_str().unwrap()],
+        "not an experiment shard of this varspec version (re-run shards an older one wrote)",
+    );
+    assert!(!out.join("variances.csv").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_rerun_keeps_the_notes_written_by_hand_below_the_marker() {
     let dir = temp_dir("experiment-notes");

@@ -229,7 +229,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 let e = sampler_variance(f.as_ref(), count, form, |r| {
                     source.get(r).map_err(|e| realization_error(r, e))
                 })?;
-                if e.variance <= e.rounding_bound {
+                // The spatial form bounds its rounding; the Fourier form
+                // has no such bound (0), and a variance of 0 is refused below.
+                if e.rounding_bound > 0.0 && e.variance <= e.rounding_bound {
                     bail!(
                         "N = {n}: the variance {:e} is below the spatial form's rounding bound \
                          {:e}: it is zero to rounding ({label} integrates {name} to machine precision \

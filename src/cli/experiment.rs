@@ -116,8 +116,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 }
 
 pub fn merge(a: MergeArgs) -> anyhow::Result<()> {
-    let shards: Vec<ShardFile> =
-        read_shard_files(&a.folder, SHARD_PREFIX, 1 << 30, "an experiment shard")?;
+    let shards: Vec<ShardFile> = read_shard_files(
+        &a.folder,
+        SHARD_PREFIX,
+        1 << 30,
+        "an experiment shard of this varspec version (re-run shards an older one wrote)",
+    )?;
     let (e, file, cells) = merge_shards(&shards)?;
     let out = a.output.unwrap_or(a.folder);
     std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;

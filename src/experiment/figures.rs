@@ -905,14 +905,16 @@ impl FigureExperiment {
                 for &requested in n {
                     let (s, m) = registry::build_nearest(sampler, requested, Some(4), &[])?;
                     let sheared = Sheared::new(s.as_ref(), *shear)?;
+                    // Each N its own stream, as converge's levels.
+                    let seed = crate::rng::level_seed(self.seed, m);
                     let measure = |s: &dyn Sampler| {
                         empirical_shifting(
                             f.as_ref(),
                             *realizations,
-                            self.seed.wrapping_add(1),
+                            seed.wrapping_add(1),
                             &[0, 1],
                             |r| {
-                                s.sample(&mut set_rng(self.seed, r as u64))
+                                s.sample(&mut set_rng(seed, r as u64))
                                     .map_err(VarianceError::from)
                             },
                         )
@@ -957,12 +959,13 @@ impl FigureExperiment {
                 };
                 line_plot_png(&plot, &out.join(file))?;
                 Ok(format!(
-                    "- `{file}`: {sampler} on `{}`, estimator shifted in (x, y) only (shifts \
-                     seeded {}), {realizations} realizations per N; slope {sb:.2} unsheared, {sa:.2} sheared \
+                    "- `{file}`: {sampler} on `{}`, estimator shifted in (x, y) only (each N \
+                     draws its sets and shifts from its own seed, derived from {}), {realizations} \
+                     realizations per N; slope {sb:.2} unsheared, {sa:.2} sheared \
                      by (a, b) = ({}, {}).\n\n\
                      | N | unsheared | sheared | ratio |\n|---|---|---|---|\n{rows}",
                     f.spec(),
-                    self.seed.wrapping_add(1),
+                    self.seed,
                     shear[0],
                     shear[1]
                 ))

@@ -145,13 +145,13 @@ pub fn write_results(
                         } else {
                             String::new()
                         };
-                        if c.variance <= c.rounding_bound {
+                        if c.rounding_bound > 0.0 && c.variance <= c.rounding_bound {
                             return format!("0 to rounding (≤ {:.0e}){mark}{n}", c.rounding_bound);
                         }
                         // Sets that all give one variance (a lattice's is
                         // the same at every offset) differ by rounding only.
                         let err = c.stderr.map_or("± unknown (1 set)".into(), |s| {
-                            if s <= c.rounding_bound {
+                            if c.rounding_bound > 0.0 && s <= c.rounding_bound {
                                 "± 0 to rounding".into()
                             } else {
                                 format!("± {s:.1e}")
@@ -201,7 +201,7 @@ pub fn write_results(
         // A variance zero to rounding has no logarithm worth fitting.
         let fit = |s: usize, i: usize| {
             fit_of(s, i, &|c| {
-                (c.variance > c.rounding_bound).then_some(c.variance)
+                (c.rounding_bound == 0.0 || c.variance > c.rounding_bound).then_some(c.variance)
             })
         };
         let radial_fit = |s: usize, i: usize| fit_of(s, i, &|c| c.radial.map(|r| r.variance));
