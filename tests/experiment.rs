@@ -179,6 +179,62 @@ fn variances_zero_to_rounding_are_reported_as_such_and_not_fitted() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The slope table says "outside the interval" exactly where slopes.csv's
+/// unrounded interval excludes the theory: two decimals showed jitter's
+/// [-1.49575, -1.48705] as [-1.50, -1.49], seemingly holding -1.5. Here
+/// Poisson disk's interval excludes its asymptotic -1 and jitter's holds
+/// -1.5, so the check fails both ways.
+#[test]
+fn the_slope_table_marks_a_theory_outside_the_interval() {
+    let dir = temp_dir("experiment-outside");
+    let file = dir.join("e.json");
+    let out = dir.join("out");
+    std::fs::write(
+        &file,
+        r#"{"name": "outside", "samplers": ["jitter", "poisson-disk"],
+            "integrands": ["disk:r=0.3"], "n": [64, 256, 1024, 4096], "sets": 8}"#,
+    )
+    .unwrap();
+    ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let md = std::fs::read_to_string(out.join("README.md")).unwrap();
+    let slopes = std::fs::read_to_string(out.join("slopes.csv")).unwrap();
+    let mut marked = Vec::new();
+    for line in slopes.lines().skip(1) {
+        let sampler = line.split(',').next().unwrap();
+        let cols: Vec<f64> = line
+            .rsplitn(4, ',')
+            .take(3)
+            .map(|c| c.parse().unwrap())
+            .collect();
+        let (theory, high, low) = (cols[0], cols[1], cols[2]);
+        let outside = theory < low || theory > high;
+        let row = md
+            .lines()
+            .filter(|l| l.starts_with(&format!("| {sampler} |")))
+            .last()
+            .unwrap();
+        assert_eq!(
+            row.contains("outside the interval"),
+            outside,
+            "{line}: README row {row}"
+        );
+        marked.push((sampler.to_string(), outside));
+    }
+    assert_eq!(
+        marked,
+        [
+            ("jitter".to_string(), false),
+            ("poisson-disk".to_string(), true)
+        ]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Shards written before cells carried their rounding bound (and before
 /// each N drew its own seed) are refused with a reason, not merged into
 /// tables that would give their levels seeds they were not drawn with.
@@ -195,7 +251,10 @@ fn shards_of_an_older_version_are_refused_not_merged() {
     let mut v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&shard).unwrap()).unwrap();
     for cell in v["cells"].as_array_mut().unwrap() {
-        cell.as_object_mut().unwrap().remove("rounding_bound").unwrap();
+        cell.as_object_mut()
+            .unwrap()
+            .remove("rounding_bound")
+            .unwrap();
     }
     std::fs::write(&shard, v.to_string()).unwrap();
     assert_fails(

@@ -219,7 +219,19 @@ pub fn write_results(
             &|s, i| {
                 let theory =
                     theoretical_rate(&e.samplers[s], functions[i].class(), functions[i].dim());
-                let th = theory.map_or(String::new(), |t| format!(" ({t})"));
+                // Two decimals can round an excluding interval onto the
+                // theory (-1.49575 shows as -1.50): say it outside in words.
+                let outside = match (theory, fit(s, i).and_then(|f| f.slope_ci)) {
+                    (Some(t), Some((l, h))) => t < l || t > h,
+                    _ => false,
+                };
+                let th = theory.map_or(String::new(), |t| {
+                    if outside {
+                        format!(" ({t}, outside the interval)")
+                    } else {
+                        format!(" ({t})")
+                    }
+                });
                 match shown(fit(s, i)) {
                     None => format!(
                         "no slope: fewer than two distinct N, or a variance zero to rounding{th}"
