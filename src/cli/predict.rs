@@ -110,6 +110,8 @@ pub struct Args {
 
 /// The empirical predictor's realizations without --realizations.
 const DEFAULT_REALIZATIONS: usize = 10_000;
+/// The Fourier form's NUFFT tolerance without --tol.
+const DEFAULT_TOLERANCE: f64 = 1e-10;
 
 /// A standard error over `sets` realizations: unknown (JSON null) from one.
 fn known_stderr(stderr: f64, sets: usize) -> Option<f64> {
@@ -239,10 +241,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let half = res.saturating_sub(1) / 2;
         let start = Instant::now();
         let bar = progress::bar(sets as u64, "Fourier form, sets");
-        let parts = fourier_parts(f.as_ref(), half, a.tol.unwrap_or(1e-10), sets, |r| {
-            bar.inc(1);
-            lend(r)
-        })?;
+        let parts = fourier_parts(
+            f.as_ref(),
+            half,
+            a.tol.unwrap_or(DEFAULT_TOLERANCE),
+            sets,
+            |r| {
+                bar.inc(1);
+                lend(r)
+            },
+        )?;
         bar.finish_and_clear();
         let seconds = start.elapsed().as_secs_f64();
         if wants(MethodArg::Radial) {
