@@ -371,10 +371,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map_or("n/a (needs 3 or more N)".into(), |(l, h)| {
             format!("[{l:.3}, {h:.3}]")
         });
-    let outside = match (theory, fit.slope_ci) {
-        (Some(t), Some((l, h))) => t < l || t > h,
-        _ => false,
-    };
+    let outside = fit.excludes(theory);
     let theory = theory.map_or("none in the table".into(), |t| format!("{t}"));
     outln!("slope {:.3}, 95% CI {ci}; theory {theory}", fit.slope);
     if outside {

@@ -221,10 +221,7 @@ pub fn write_results(
                     theoretical_rate(&e.samplers[s], functions[i].class(), functions[i].dim());
                 // Two decimals can round an excluding interval onto the
                 // theory (-1.49575 shows as -1.50): say it outside in words.
-                let outside = match (theory, fit(s, i).and_then(|f| f.slope_ci)) {
-                    (Some(t), Some((l, h))) => t < l || t > h,
-                    _ => false,
-                };
+                let outside = fit(s, i).is_some_and(|f| f.excludes(theory));
                 let th = theory.map_or(String::new(), |t| {
                     if outside {
                         format!(" ({t}, outside the interval)")

@@ -16,6 +16,17 @@ pub struct SlopeFit {
     pub intercept: f64,
 }
 
+impl SlopeFit {
+    /// Whether the 95% interval excludes `rate` (false without an
+    /// interval, or without a rate).
+    pub fn excludes(&self, rate: Option<f64>) -> bool {
+        match (rate, self.slope_ci) {
+            (Some(t), Some((low, high))) => t < low || t > high,
+            _ => false,
+        }
+    }
+}
+
 /// The 97.5% quantiles of Student's t for 1..=30 degrees of freedom (the
 /// two-sided 95% interval), to 9 decimals (scipy.stats.t.ppf(0.975, ν);
 /// Abramowitz & Stegun Table 26.10 gives the first 3).
