@@ -134,33 +134,28 @@ pub fn metadata(
     } else {
         PredictedVariances::OverBudget { pairs }
     };
-    let single = matches!(format, TableFormat::F32 | TableFormat::CHeader);
     // A single-precision table is predicted on the values it stores.
-    let stored: Vec<PointSet> = if single && status == PredictedVariances::Computed {
-        sets.iter()
-            .map(|s| {
-                let coords = s
-                    .coords()
-                    .iter()
-                    .map(|&x| f64::from(to_unit_f32(x)))
-                    .collect();
-                let stored =
-                    PointSet::new(dim, coords).expect("f32 values of [0, 1) points lie in [0, 1)");
-                match s.density() {
-                    Some(density) => stored.with_density(density),
-                    None => Ok(stored),
-                }
-            })
-            .collect::<Result<_, _>>()
-            .expect("the density was valid on the f64 set")
-    } else {
-        Vec::new()
-    };
-    let sets = if single && status == PredictedVariances::Computed {
-        &stored[..]
-    } else {
-        sets
-    };
+    let single = matches!(format, TableFormat::F32 | TableFormat::CHeader);
+    let stored: Option<Vec<PointSet>> =
+        (single && status == PredictedVariances::Computed).then(|| {
+            sets.iter()
+                .map(|s| {
+                    let coords = s
+                        .coords()
+                        .iter()
+                        .map(|&x| f64::from(to_unit_f32(x)))
+                        .collect();
+                    let stored = PointSet::new(dim, coords)
+                        .expect("f32 values of [0, 1) points lie in [0, 1)");
+                    match s.density() {
+                        Some(density) => stored.with_density(density),
+                        None => Ok(stored),
+                    }
+                })
+                .collect::<Result<_, _>>()
+                .expect("the density was valid on the f64 set")
+        });
+    let sets = stored.as_deref().unwrap_or(sets);
     let predicted_variance = if status == PredictedVariances::Computed {
         REFERENCE_INTEGRANDS
             .iter()

@@ -127,6 +127,22 @@ fn names_that_leave_the_output_folder_are_refused() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Runs the experiment file `json` in a fresh temporary folder named after
+/// `tag`; returns the folder (to remove) and the run's output folder.
+fn run_in_temp(tag: &str, json: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+    let dir = temp_dir(tag);
+    let file = dir.join("e.json");
+    let out = dir.join("out");
+    std::fs::write(&file, json).unwrap();
+    ok(&[
+        "experiment",
+        file.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    (dir, out)
+}
+
 /// A variance at or below the spatial form's rounding bound is reported as
 /// zero to rounding and left out of the slopes (a grid integrates
 /// cos(2πx) exactly: 2e-17 of noise used to be tabulated and fitted), and
@@ -134,21 +150,11 @@ fn names_that_leave_the_output_folder_are_refused() {
 /// variance: shifting a lattice does not change it) reads as 0.
 #[test]
 fn variances_zero_to_rounding_are_reported_as_such_and_not_fitted() {
-    let dir = temp_dir("experiment-rounding");
-    let file = dir.join("e.json");
-    let out = dir.join("out");
-    std::fs::write(
-        &file,
+    let (dir, out) = run_in_temp(
+        "experiment-rounding",
         r#"{"name": "rounding", "samplers": ["regular", "uniform-jitter"],
             "integrands": ["cos:kx=1", "disk:r=0.3"], "n": [16, 64, 256], "sets": 4}"#,
-    )
-    .unwrap();
-    ok(&[
-        "experiment",
-        file.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    );
     let md = std::fs::read_to_string(out.join("README.md")).unwrap();
     let rows: Vec<&str> = md
         .lines()
@@ -186,21 +192,11 @@ fn variances_zero_to_rounding_are_reported_as_such_and_not_fitted() {
 /// -1.5, so the check fails both ways.
 #[test]
 fn the_slope_table_marks_a_theory_outside_the_interval() {
-    let dir = temp_dir("experiment-outside");
-    let file = dir.join("e.json");
-    let out = dir.join("out");
-    std::fs::write(
-        &file,
+    let (dir, out) = run_in_temp(
+        "experiment-outside",
         r#"{"name": "outside", "samplers": ["jitter", "poisson-disk"],
             "integrands": ["disk:r=0.3"], "n": [64, 256, 1024, 4096], "sets": 8}"#,
-    )
-    .unwrap();
-    ok(&[
-        "experiment",
-        file.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    );
     let md = std::fs::read_to_string(out.join("README.md")).unwrap();
     let slopes = std::fs::read_to_string(out.join("slopes.csv")).unwrap();
     let mut marked = Vec::new();
