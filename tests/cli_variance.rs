@@ -625,7 +625,8 @@ fn converge_on_a_square_family_matches_predict_and_the_jitter_rate() {
 /// Where the theory's rate falls outside the fitted interval, the text says
 /// so (Poisson disk's N^-1 is asymptotic: -1.2 over 64…1024); where it falls
 /// inside, it does not. A variance that is zero to rounding (a grid on a
-/// cosine it integrates exactly) is refused instead of fitted.
+/// cosine it integrates exactly) is refused instead of fitted, by either
+/// form.
 #[test]
 fn converge_notes_a_theory_outside_the_interval_and_refuses_rounding_noise() {
     let text = |sampler: &str| {
@@ -659,4 +660,19 @@ fn converge_notes_a_theory_outside_the_interval_and_refuses_rounding_noise() {
         ],
         "zero to rounding",
     );
+    // The Fourier form too: uniform jitter's Gaussian variance from
+    // N = 256 on is the Parseval tail's rounding (exact: ~1e-46).
+    let args = [
+        "converge",
+        "--sampler",
+        "uniform-jitter",
+        "--integrand",
+        "gaussian",
+        "--method",
+        "fourier",
+        "--n",
+        "64,256,1024",
+    ];
+    common::assert_fails(&args, "N = 256: the variance");
+    common::assert_fails(&args, "at or below the fourier form's rounding bound");
 }

@@ -334,3 +334,39 @@ fn assert_within_truncation_bound(four: &FourierEstimate, s: &SpatialEstimate) {
         four.truncation_bound
     );
 }
+
+/// A set that integrates f exactly reads as zero to rounding in both
+/// forms, not as the arithmetic's residue: uniform jitter 16×16 on the
+/// default Gaussian (σ = 0.1) has exact variance Σ over its dual lattice
+/// 16·Z² of P_f ≈ 4·(2πσ²)²·e^(−4π²σ²·256) ≈ 2e-46, so any larger value is
+/// rounding, and a regular 8×8 grid on cos(2πx) has variance exactly 0. A
+/// random set's rounding bounds stay negligible beside its variance.
+#[test]
+fn exact_integration_is_zero_to_rounding_in_both_forms() {
+    for (sampler, n, spec) in [
+        ("uniform-jitter", 256, "gaussian"),
+        ("regular", 64, "cos:kx=1"),
+    ] {
+        let (four, s) = fourier_beside_spatial(spec, sampler, n, (9, 4), 127);
+        assert!(
+            four.variance <= four.rounding_bound && four.rounding_bound < 1e-15,
+            "{sampler} on {spec}: Fourier {:e} above its rounding bound {:e} (or the bound above 1e-15)",
+            four.variance,
+            four.rounding_bound
+        );
+        assert!(
+            s.variance <= s.rounding_bound && s.rounding_bound < 1e-15,
+            "{sampler} on {spec}: spatial {:e} above its rounding bound {:e}",
+            s.variance,
+            s.rounding_bound
+        );
+    }
+    let (four, s) = fourier_beside_spatial("disk:r=0.3", "random", 1024, (9, 4), 127);
+    assert!(
+        four.rounding_bound < 1e-6 * four.variance && s.rounding_bound < 1e-9 * s.variance,
+        "random on a disk: rounding bounds {:e} (Fourier) and {:e} (spatial) against {:e}",
+        four.rounding_bound,
+        s.rounding_bound,
+        s.variance
+    );
+}

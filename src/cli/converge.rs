@@ -229,14 +229,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 let e = sampler_variance(f.as_ref(), count, form, |r| {
                     source.get(r).map_err(|e| realization_error(r, e))
                 })?;
-                // The spatial form bounds its rounding; the Fourier form
-                // has no such bound (0), and a variance of 0 is refused below.
                 if e.rounding_bound > 0.0 && e.variance <= e.rounding_bound {
                     bail!(
-                        "N = {n}: the variance {:e} is below the spatial form's rounding bound \
+                        "N = {n}: the variance {:e} is at or below the {} form's rounding bound \
                          {:e}: it is zero to rounding ({label} integrates {name} to machine precision \
                          at this N), and a log-log slope through it would fit rounding noise",
                         e.variance,
+                        e.method,
                         e.rounding_bound
                     );
                 }

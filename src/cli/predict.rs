@@ -269,7 +269,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             out.insert(
                 "fourier".into(),
                 json!({
-                    "variance": e.variance, "truncation_bound": e.truncation_bound, "in_box": e.in_box,
+                    "variance": e.variance, "truncation_bound": e.truncation_bound, "rounding_bound": e.rounding_bound, "in_box": e.in_box,
                     "tail": e.tail, "count_term": e.count_term, "stderr": known_stderr(e.stderr, e.sets), "res": res, "sets": e.sets,
                     "seconds": seconds,
                 }),

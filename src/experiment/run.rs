@@ -33,9 +33,9 @@ pub struct Cell {
     pub variance: f64,
     /// Its standard error; `None` from a single set (unknown, not 0).
     pub stderr: Option<f64>,
-    /// The spatial form's bound on its rounding (0 for the Fourier form,
-    /// which has none): a variance at or below a positive bound is zero to
-    /// rounding. Required in shard files: shards written before it (and
+    /// The form's bound on its rounding (see
+    /// [`SamplerVariance`](crate::variance::SamplerVariance)): a variance at
+    /// or below a positive bound is zero to rounding. Required in shard files: shards written before it (and
     /// before each N drew its own seed) are refused, not merged.
     pub rounding_bound: f64,
     /// `spatial` or `fourier`.

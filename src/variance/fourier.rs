@@ -33,6 +33,19 @@
 //! an estimate from the data, not a theorem: it assumes the shell
 //! represents the frequencies beyond it.
 //!
+//! Rounding: a set that integrates f exactly (uniform jitter on a smooth
+//! bump) has a Fourier variance of zero, and the computed one is what the
+//! arithmetic leaves. Two sources bound it. The transform's error is
+//! |ΔS(k)| ≲ e = ε·N at tolerance ε (BMK 2019; the NUFFT module doc), so
+//! N·P_S = |S|²/N is off by at most (2|S|·e + e²)/N per frequency, with
+//! E|S| ≤ √(E|S|²) (Jensen) from the expected power; weighted by P_f and
+//! summed over the box. The tail T = c_f(0) − Σ_(k∈B) P_f is a difference
+//! of computed sums, off by about 4u·(c_f(0) + I² + Σ P_f) for the unit
+//! roundoff u (c_f(0) is itself a difference of its closed form's terms).
+//! The bound is their sum over N; for a white-noise-like set it is about
+//! 2ε√N relative, for a lattice on a smooth f it is the tail's rounding,
+//! which is what an unguarded log-log fit would otherwise fit.
+//!
 //! Sets with a density λ (a random number of points, weight 1/λ) use
 //! P_S = |S|²/λ and λ in place of N throughout, plus the k = 0 term
 //! E[(N/λ − 1)²]·I², the variance the random count adds (docs/mathematics.md
@@ -62,6 +75,10 @@ pub struct FourierEstimate {
     pub stderr: f64,
     /// Bound on the error of the tail term (see the module doc).
     pub truncation_bound: f64,
+    /// Bound on what the transform's tolerance and floating point put into
+    /// the value (see the module doc, "Rounding"): a variance at or below
+    /// it is zero to rounding (a lattice integrating f exactly).
+    pub rounding_bound: f64,
     /// The part from inside the box.
     pub in_box: f64,
     /// The Parseval tail term T/N.
@@ -262,6 +279,20 @@ where
     } else {
         (bias * tail_mass + 3.0 * spread * (tail_mass * pf_max).sqrt()) / nf
     };
+    let rounding_bound = {
+        let largest = counts.iter().copied().max().unwrap_or(0) as f64;
+        let e = tolerance * largest;
+        let mut transform = NeumaierSum::default();
+        for (idx, (&p, &w)) in spectrum.power.iter().zip(&pf).enumerate() {
+            if idx != zero {
+                let s = (p.max(0.0) * nf).sqrt();
+                transform.add((2.0 * s * e + e * e) / nf * w);
+            }
+        }
+        let integral = f.integral();
+        let sums = f.variance().abs() + integral * integral + mass.value() + in_box.value();
+        (transform.value() + 4.0 * f64::EPSILON * sums) / nf
+    };
     let in_box = in_box.value() / nf;
     let tail = tail_mass / nf;
     // Per-set values (in-box part and count term) for the standard error.
@@ -276,6 +307,7 @@ where
             variance: in_box + tail + count_term,
             stderr,
             truncation_bound,
+            rounding_bound,
             in_box,
             tail,
             count_term,

@@ -34,9 +34,10 @@ pub struct SamplerVariance {
     pub stderr: f64,
     /// The Fourier form's truncation bound (0 for the spatial form).
     pub truncation_bound: f64,
-    /// The spatial form's bound on its floating-point rounding, the largest
-    /// over the realizations (0 for the Fourier form): a variance below it
-    /// is zero to rounding (a lattice integrating a cosine exactly).
+    /// The form's bound on its rounding (the spatial form's compensated
+    /// sums, largest over the realizations; the Fourier form's transform
+    /// tolerance and Parseval tail): a variance at or below it is zero to
+    /// rounding (a lattice integrating a cosine exactly).
     pub rounding_bound: f64,
     /// `spatial` or `fourier`.
     pub method: &'static str,
@@ -74,7 +75,7 @@ where
             variance: p.variance,
             stderr: p.stderr,
             truncation_bound: p.truncation_bound,
-            rounding_bound: 0.0,
+            rounding_bound: p.rounding_bound,
             method: "fourier",
         })
     };
