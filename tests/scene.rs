@@ -524,6 +524,13 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
             "v 0 0 0\nv 9e8 0 0\nv 0 1 0\nf 1 2 3\n",
             "objects[0].scale = [1.5, 1.0, 1.0]: a placement whose vertices",
         ),
+        // Within 1e9 after scaling; the translation's z of −6 takes a
+        // vertex to −1.000000005e9: the translation is to blame.
+        (
+            "moved.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 0 -999999999\nf 1 2 3\n",
+            "objects[0].translate = [0.013, 0.0, -6.0]: a placement whose vertices",
+        ),
     ];
     let mut cases: Vec<(String, &str)> = vec![
         (r#""shape": "obj""#.into(), "objects[0].file"),

@@ -23,7 +23,9 @@ const BYTES_PER_OBJ_BYTE: f64 = 32.0;
 /// for memory, malformed, no faces (or only faces of zero area), a
 /// position that is not finite or beyond [`MAX_LENGTH`], or a face that
 /// refers to a missing vertex; on `objects[index].scale` when the placed
-/// vertices reach beyond [`MAX_LENGTH`] (an OBJ's 1e9 times a scale of 1e9).
+/// vertices reach beyond [`MAX_LENGTH`] (an OBJ's 1e9 times a scale of
+/// 1e9), on `objects[index].translate` when only the translation takes
+/// them there.
 pub fn object_triangles(
     object: &ObjectFile,
     index: usize,
@@ -43,16 +45,29 @@ pub fn object_triangles(
         }
     };
     let place = Placement::of(object);
-    let reach = triangles
-        .iter()
-        .flatten()
-        .flat_map(|&p| place.apply(p))
-        .fold(0.0_f64, |m, c| m.max(c.abs()));
+    // How far the placed vertices reach, and how far they would without
+    // the translation: the field to blame is `scale` when the scaled
+    // (and rotated) model alone is too large, else `translate`.
+    let (reach, unmoved) = triangles.iter().flatten().map(|&p| place.apply(p)).fold(
+        (0.0_f64, 0.0_f64),
+        |(all, own), w| {
+            let moved = (0..3).map(|i| w[i].abs()).fold(0.0, f64::max);
+            let kept = (0..3)
+                .map(|i| (w[i] - object.translate[i]).abs())
+                .fold(0.0, f64::max);
+            (all.max(moved), own.max(kept))
+        },
+    );
     if reach > MAX_LENGTH {
+        let (field, value) = if unmoved > MAX_LENGTH {
+            ("scale", object.scale)
+        } else {
+            ("translate", object.translate)
+        };
         return Err(SceneError::Field {
             source_name: source_name.into(),
-            field: format!("objects[{index}].scale"),
-            value: format!("{:?}", object.scale),
+            field: format!("objects[{index}].{field}"),
+            value: format!("{value:?}"),
             expected: format!(
                 "a placement whose vertices (scale × model + translate) stay within {MAX_LENGTH:e} \
                  of the origin (the BVH intersects in f32); this object reaches {}",
