@@ -250,6 +250,7 @@ fn bad_specs_are_clear_errors() {
         ("cos:kx=1.5", "integer"),
         ("defocus:shape=star", "box, disk or gaussian"),
         ("halfplane:offset=inf", "[-1, 1]"),
+        ("layers:c1=0.3,c2=0.26", "at least 0.05 from c1"),
     ] {
         let e = err(spec).to_string();
         assert!(
@@ -261,6 +262,10 @@ fn bad_specs_are_clear_errors() {
         parse("gaussian:sx=0.2").spec(),
         "gaussian:sx=0.2,sy=0.2,angle=0,cx=0.5,cy=0.5"
     );
+    // Exactly 0.05 apart as written (0.0499…9 in binary) is allowed.
+    for spec in ["layers:c1=0.3,c2=0.25", "layers:c1=0.5,c2=0.45"] {
+        assert!(integrands::parse(spec).is_ok(), "{spec} refused");
+    }
 }
 
 #[test]

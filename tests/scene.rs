@@ -448,6 +448,35 @@ fn plane_text(shape: &str) -> String {
     )
 }
 
+/// A shadow segment covers its whole length, from its origin on: an
+/// occluder 1.5e-4 in front of a shadow ray's offset origin blocks it (the
+/// segment once skipped the offset again at each end, so contact shadows
+/// within 2e-4 went missing), one just beyond its end does not. Both BVHs.
+#[test]
+fn shadow_segments_start_at_their_origin_and_end_at_their_length() {
+    use varspec::scene::geometry::BvhKind;
+    for kind in [BvhKind::Cwbvh, BvhKind::Bvh2] {
+        let scene =
+            Scene::from_text_with(&plane_text(r#""shape": "quad""#), "plane", kind).unwrap();
+        // The quad lies in z = −6; the ray leaves z = −6 + 1.5e-4 towards it.
+        let origin = [0.2, 0.1, -6.0 + 1.5e-4];
+        let down = [0.0, 0.0, -1.0];
+        let g = scene.geometry();
+        assert!(
+            !g.unoccluded(origin, down, 3e-4),
+            "{kind:?}: the quad at 1.5e-4 missed"
+        );
+        assert!(
+            g.unoccluded(origin, down, 1e-4),
+            "{kind:?}: hit beyond the segment's end"
+        );
+        assert!(
+            g.unoccluded(origin, [0.0, 0.0, 1.0], 10.0),
+            "{kind:?}: hit behind the origin"
+        );
+    }
+}
+
 /// An OBJ file holding the built-in quad (one polygon face, triangulated as
 /// a fan into the built-in quad's two triangles), read relative to the
 /// scene file's folder, renders exactly the built-in quad's pixels.

@@ -409,7 +409,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
                     let d: [f64; 3] = std::array::from_fn(|k| light[k] - p[k]);
                     let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
                     let dir = d.map(|c| c / len);
-                    scene.geometry().unoccluded(**p, dir, 1e-4, len - 1e-4)
+                    scene.geometry().unoccluded(**p, dir, len - 1e-4)
                 })
                 .count()
         });

@@ -18,6 +18,9 @@ pub struct IntegrandInfo {
     pub params: &'static [(&'static str, &'static str, &'static str)],
 }
 
+/// The least |c2 − c1| of `layers`: closer layers are one defocus.
+const LAYERS_MIN_SEPARATION: f64 = 0.05;
+
 /// Every integrand.
 pub const INTEGRANDS: &[IntegrandInfo] = &[
     IntegrandInfo {
@@ -289,7 +292,9 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
         "layers" => {
             let shear = |key| p.number(key, |c: f64| c.abs() <= 16.0, "a shear in [-16, 16]");
             let (c1, c2) = (shear("c1")?, shear("c2")?);
-            if (c2 - c1).abs() < 0.05 {
+            // 0.05 as written: c1 = 0.3, c2 = 0.25 differ by 0.0499…9 in
+            // binary, and the spec's decimals are what the user compares.
+            if (c2 - c1).abs() < LAYERS_MIN_SEPARATION * (1.0 - 1e-12) {
                 return Err(p.bad("c2", "a shear at least 0.05 from c1 (else use defocus)"));
             }
             Box::new(Layers::new(

@@ -290,21 +290,12 @@ impl Geometry {
         })
     }
 
-    /// Whether the segment from `origin` to `origin + t_max·direction`
-    /// (excluding `t_min` at each end) meets no triangle.
-    pub fn unoccluded(
-        &self,
-        origin: [f64; 3],
-        direction: [f64; 3],
-        t_min: f64,
-        t_max: f64,
-    ) -> bool {
-        let ray = Ray::new(
-            f32v(origin),
-            f32v(direction),
-            t_min as f32,
-            (t_max - t_min) as f32,
-        );
+    /// Whether the segment from `origin` to `origin + length·direction`
+    /// meets no triangle (any-hit traversal). The caller keeps the segment
+    /// off the surfaces at its ends: an origin offset along the normal, a
+    /// length stopping short of the light.
+    pub fn unoccluded(&self, origin: [f64; 3], direction: [f64; 3], length: f64) -> bool {
+        let ray = Ray::new(f32v(origin), f32v(direction), 0.0, length as f32);
         let intersect =
             |ray: &Ray, slot: usize| self.triangles[self.primitive(slot)].intersect(ray);
         match &self.tree {

@@ -326,9 +326,15 @@ impl Scene {
         if cos_surface <= 0.0 || cos_light <= 0.0 {
             return 0.0;
         }
+        // Leave the surface by the offset along its normal and stop that
+        // far short of the light: once at each end (the segment used to
+        // skip it twice at each, missing occluders within 2·eps).
         let eps = ray_offset(point, reach);
         let origin: [f64; 3] = std::array::from_fn(|k| point[k] + eps * normal[k]);
-        if !self.geometry.unoccluded(origin, dir, eps, r - eps) {
+        let span = description::sub(at, origin);
+        let length = dot(span, span).sqrt();
+        let towards = span.map(|c| c / length);
+        if !self.geometry.unoccluded(origin, towards, length - eps) {
             return 0.0;
         }
         light.radiance * cos_surface * cos_light / (std::f64::consts::PI * r2)
