@@ -1336,5 +1336,8 @@ fn estimated_shear_search_is_identical_on_one_and_two_threads() {
     let one = run("1");
     let estimated = |h: usize| one["objective"]["realizations"][h].as_u64().unwrap() > 0;
     assert!(estimated(0) && estimated(1), "both halves estimated: {one}");
+    // Estimated halves leave J(unsheared) a standard error of its own.
+    let unsheared = one["objective"]["unsheared_stderr"].as_f64();
+    assert!(unsheared.is_some_and(|s| s > 0.0 && s < 0.5), "{one}");
     assert_eq!(one, run("2"));
 }

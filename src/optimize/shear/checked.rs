@@ -247,6 +247,7 @@ pub fn search_and_check(
             "description": "expected variance of the estimator over the sampler's randomness (closed form where the halves have one)",
             "unsheared": found.unsheared.value, "initial": found.initial.1, "optimum": found.optimum.value,
             "stderr": (found.optimum.value > 0.0).then(|| found.optimum.stderr / found.optimum.value),
+            "unsheared_stderr": (found.unsheared.value > 0.0).then(|| found.unsheared.stderr / found.unsheared.value),
             "truncation_bound": (found.optimum.value > 0.0).then(|| objective.truncation_bound() / found.optimum.value),
             "evaluations": found.evaluations, "coarse_evaluations": found.coarse_evaluations,
             "terms": objective.terms(), "coarse_terms": objective.coarse_terms(), "half": objective.half(),
