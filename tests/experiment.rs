@@ -147,28 +147,37 @@ fn run_in_temp(tag: &str, json: &str) -> (std::path::PathBuf, std::path::PathBuf
 /// zero to rounding and left out of the slopes (a grid integrates
 /// cos(2πx) exactly: 2e-17 of noise used to be tabulated and fitted), and
 /// a standard error at rounding level (uniform jitter's sets all give one
-/// variance: shifting a lattice does not change it) reads as 0.
+/// variance: shifting a lattice does not change it) reads as 0. The radial
+/// form gets no relative error against such a reference.
 #[test]
 fn variances_zero_to_rounding_are_reported_as_such_and_not_fitted() {
     let (dir, out) = run_in_temp(
         "experiment-rounding",
         r#"{"name": "rounding", "samplers": ["regular", "uniform-jitter"],
-            "integrands": ["cos:kx=1", "disk:r=0.3"], "n": [16, 64, 256], "sets": 4}"#,
+            "integrands": ["cos:kx=1", "disk:r=0.3"], "n": [16, 64, 256], "sets": 4,
+            "radial": {"half": 20}}"#,
     );
     let md = std::fs::read_to_string(out.join("README.md")).unwrap();
     let rows: Vec<&str> = md
         .lines()
         .filter(|l| l.starts_with("| regular |"))
         .collect();
-    assert_eq!(rows.len(), 4, "three N and the slopes: {md}");
+    assert_eq!(
+        rows.len(),
+        8,
+        "three N twice (variance, radial error), two slopes: {md}"
+    );
+    let cos = |row: &str| row.split(" | ").nth(1).unwrap().to_string();
     for row in &rows[..3] {
-        let cos = row.split(" | ").nth(1).unwrap();
-        assert!(cos.starts_with("0 to rounding (≤ "), "{row}");
+        assert!(cos(row).starts_with("0 to rounding (≤ "), "{row}");
+    }
+    for row in &rows[3..6] {
+        assert_eq!(cos(row), "reference 0 to rounding", "{row}");
     }
     assert!(
-        rows[3].contains("no slope: fewer than two distinct N, or a variance zero to rounding"),
+        rows[6].contains("no slope: fewer than two distinct N, or a variance zero to rounding"),
         "{}",
-        rows[3]
+        rows[6]
     );
     let uniform = md
         .lines()

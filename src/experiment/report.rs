@@ -174,11 +174,18 @@ pub fn write_results(
                 &mut md,
                 &format!("Radial form's relative error at N ≈ {requested}"),
                 &|s, i| {
-                    pick(s, i)
-                        .into_iter()
-                        .find(|c| c.n_index == ni)
-                        .and_then(|c| c.radial.map(|r| r.variance / c.variance - 1.0))
-                        .map_or("–".into(), |x| format!("{x:+.2}"))
+                    let cell = pick(s, i).into_iter().find(|c| c.n_index == ni);
+                    match cell.and_then(|c| c.radial.map(|r| (c, r))) {
+                        // No relative error against a reference that is
+                        // rounding noise.
+                        Some((c, _))
+                            if c.rounding_bound > 0.0 && c.variance <= c.rounding_bound =>
+                        {
+                            "reference 0 to rounding".into()
+                        }
+                        Some((c, r)) => format!("{:+.2}", r.variance / c.variance - 1.0),
+                        None => "–".into(),
+                    }
                 },
             );
         }
