@@ -856,14 +856,18 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         );
         if let Some((before, after)) = check {
             outln!(
-                "check on {} fresh sets: {:.4e} [{:.4e}, {:.4e}] -> {:.4e} [{:.4e}, {:.4e}]",
+                "check on {} fresh sets: {:.4e} [{:.4e}, {:.4e}] -> {:.4e} [{:.4e}, {:.4e}]{}",
                 after.realizations,
                 before.variance,
                 before.ci_low,
                 before.ci_high,
                 after.variance,
                 after.ci_low,
-                after.ci_high
+                after.ci_high,
+                run.ratio.map_or(String::new(), |r| format!(
+                    "; paired ratio {:.3} [{:.3}, {:.3}]",
+                    r.ratio, r.ci_low, r.ci_high
+                ))
             );
         }
     }
@@ -872,10 +876,10 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     }
     match run.verdict {
         Some(CheckVerdict::Contradicts) => eprintln!(
-            "warning: the fresh-set check finds the shear worse than none (95% intervals apart), against the search's objective: do not use it; try another --seed, or keep the sets unsheared"
+            "warning: the fresh-set check finds the shear worse than none (the paired ratio's 95% interval lies above 1), against the search's objective: do not use it; try another --seed, or keep the sets unsheared"
         ),
         Some(CheckVerdict::Inconclusive) if !a.json => outln!(
-            "the check cannot tell the shear from none (95% intervals overlap): raise --realizations to separate them"
+            "the check cannot tell the shear from none (the paired ratio's 95% interval holds 1): raise --realizations to separate them"
         ),
         _ => {}
     }

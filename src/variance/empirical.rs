@@ -103,6 +103,30 @@ where
     VarianceError: From<E>,
     E: Send,
 {
+    let values = shifted_estimates(f, realizations, seed, shift_dims, realization)?;
+    Ok(EmpiricalEstimate::of(&values))
+}
+
+/// The estimates Î of the R realizations behind [`empirical_shifting`], in
+/// order: realization r under the shift drawn from stream (seed, r), so two
+/// calls with the same seed and realizations differing only by a
+/// deterministic change (a shear) are paired (see
+/// [`paired_ratio`](super::paired_ratio)).
+///
+/// # Errors
+/// As [`empirical_shifting`].
+pub fn shifted_estimates<P, E>(
+    f: &dyn Integrand,
+    realizations: usize,
+    seed: u64,
+    shift_dims: &[usize],
+    realization: impl Fn(usize) -> Result<P, E> + Sync,
+) -> Result<Vec<f64>, VarianceError>
+where
+    P: std::borrow::Borrow<PointSet>,
+    VarianceError: From<E>,
+    E: Send,
+{
     if let Some(&j) = shift_dims.iter().find(|&&j| j >= f.dim()) {
         return Err(VarianceError::Dimension {
             integrand: f.dim(),
@@ -147,29 +171,38 @@ where
             Ok(estimate(f, set, &shift))
         })
         .collect::<Result<_, VarianceError>>()?;
-    let r = realizations as f64;
-    let mean = sum(values.iter().copied()) / r;
-    let m2 = sum(values.iter().map(|v| (v - mean).powi(2)));
-    let m4 = sum(values.iter().map(|v| (v - mean).powi(4))) / r;
-    let variance = m2 / (r - 1.0);
-    let var_of_var = crate::sum::variance_of_sample_variance(m4, variance, realizations);
-    let half_width = NORMAL_95 * var_of_var.sqrt();
-    let (ci_low, ci_high) = if m2 > 0.0 {
-        bonett_interval(&values, variance, NORMAL_95)
-            .unwrap_or(((variance - half_width).max(0.0), variance + half_width))
-    } else {
-        // Every realization gave the same estimate (an integrand whose
-        // support no point met, say): the data bound nothing above 0.
-        (0.0, f64::INFINITY)
-    };
-    Ok(EmpiricalEstimate {
-        variance,
-        stderr: var_of_var.sqrt(),
-        ci_low,
-        ci_high,
-        mean,
-        realizations,
-    })
+    Ok(values)
+}
+
+impl EmpiricalEstimate {
+    /// The statistics of R ≥ 2 estimates Î (see the module doc).
+    #[must_use]
+    pub fn of(values: &[f64]) -> EmpiricalEstimate {
+        let realizations = values.len();
+        let r = realizations as f64;
+        let mean = sum(values.iter().copied()) / r;
+        let m2 = sum(values.iter().map(|v| (v - mean).powi(2)));
+        let m4 = sum(values.iter().map(|v| (v - mean).powi(4))) / r;
+        let variance = m2 / (r - 1.0);
+        let var_of_var = crate::sum::variance_of_sample_variance(m4, variance, realizations);
+        let half_width = NORMAL_95 * var_of_var.sqrt();
+        let (ci_low, ci_high) = if m2 > 0.0 {
+            bonett_interval(values, variance, NORMAL_95)
+                .unwrap_or(((variance - half_width).max(0.0), variance + half_width))
+        } else {
+            // Every realization gave the same estimate (an integrand whose
+            // support no point met, say): the data bound nothing above 0.
+            (0.0, f64::INFINITY)
+        };
+        EmpiricalEstimate {
+            variance,
+            stderr: var_of_var.sqrt(),
+            ci_low,
+            ci_high,
+            mean,
+            realizations,
+        }
+    }
 }
 
 /// Bonett's (2006, Computational Statistics & Data Analysis 50, 775–782)

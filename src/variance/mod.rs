@@ -12,15 +12,18 @@ pub mod convergence;
 pub mod empirical;
 pub mod fourier;
 pub mod measure;
+pub mod paired;
 pub mod radial;
 pub mod spatial;
 
 pub use convergence::{SlopeError, SlopeFit, fit_slope, theoretical_rate};
 pub use empirical::{
     DEFAULT_SHIFT_SEED, EmpiricalEstimate, NORMAL_95, empirical, empirical_shifting,
+    shifted_estimates,
 };
 pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_parts};
 pub use measure::{SamplerVariance, VarianceForm, fourier_half, sampler_variance};
+pub use paired::{VarianceRatio, paired_ratio};
 pub use radial::{RadialEstimate, radial_from};
 pub use spatial::{SpatialEstimate, spatial, spatial_variance};
 

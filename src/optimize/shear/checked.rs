@@ -13,32 +13,33 @@ use crate::integrands::Integrand;
 use crate::optimize::OptimizeError;
 use crate::rng::set_rng;
 use crate::samplers::Sampler;
-use crate::variance::{EmpiricalEstimate, VarianceError, empirical_shifting};
+use crate::variance::{
+    EmpiricalEstimate, VarianceError, VarianceRatio, paired_ratio, shifted_estimates,
+};
 
 /// What the fresh-set check says of the search's claim that the shear
-/// lowers the variance, from the two 95% intervals.
+/// lowers the variance, from the 95% interval of the paired ratio
+/// Var(after)/Var(before) (the same sets and shifts, sheared or not).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CheckVerdict {
-    /// The sheared interval lies wholly below the unsheared one.
+    /// The ratio's interval lies wholly below 1.
     Confirms,
-    /// The intervals overlap: the check cannot tell them apart.
+    /// The interval holds 1 (or there is no ratio: a variance of 0): the
+    /// check cannot tell the shear from none.
     Inconclusive,
-    /// The sheared interval lies wholly above the unsheared one: the
-    /// objective (an estimate, for halves without a closed form) misled
-    /// the search.
+    /// The interval lies wholly above 1: the objective (an estimate, for
+    /// halves without a closed form) misled the search.
     Contradicts,
 }
 
 impl CheckVerdict {
-    /// The verdict of the check (before, after).
+    /// The verdict of the paired ratio after/before.
     #[must_use]
-    pub fn of(before: &EmpiricalEstimate, after: &EmpiricalEstimate) -> Self {
-        if after.ci_high < before.ci_low {
-            Self::Confirms
-        } else if after.ci_low > before.ci_high {
-            Self::Contradicts
-        } else {
-            Self::Inconclusive
+    pub fn of(ratio: Option<&VarianceRatio>) -> Self {
+        match ratio {
+            Some(r) if r.ci_high < 1.0 => Self::Confirms,
+            Some(r) if r.ci_low > 1.0 => Self::Contradicts,
+            _ => Self::Inconclusive,
         }
     }
 
@@ -62,6 +63,9 @@ pub struct CheckedShear {
     /// Variance of the estimator unsheared and at the found shear on
     /// fresh realizations (None for `realizations` = 0).
     pub check: Option<(EmpiricalEstimate, EmpiricalEstimate)>,
+    /// Var(after)/Var(before) from the check's paired realizations (None
+    /// without a check, or with a variance of 0 on either side).
+    pub ratio: Option<VarianceRatio>,
     /// The check's verdict on the found shear (None without a check, or
     /// when the search kept no shear: then both sides are one estimator).
     pub verdict: Option<CheckVerdict>,
@@ -202,9 +206,11 @@ pub fn search_and_check(
         ));
     }
     let eval_seed = seed ^ 0x0e7a_1000;
-    let estimate = |shear: [f64; 2]| -> Result<EmpiricalEstimate, OptimizeError> {
+    // Realization r draws the same set and shift at every shear: the two
+    // sides are paired.
+    let estimates = |shear: [f64; 2]| -> Result<Vec<f64>, OptimizeError> {
         let sheared = Sheared::new(sampler, shear)?;
-        Ok(empirical_shifting(
+        Ok(shifted_estimates(
             f,
             realizations,
             seed ^ 1,
@@ -222,14 +228,16 @@ pub fn search_and_check(
             "checking on {realizations} fresh realizations (about {:.0} s of sampling at {per_set:.2e} s a set; --realizations sets the count)",
             2.0 * realizations as f64 * per_set / rayon::current_num_threads() as f64
         ));
-        Some((estimate([0.0, 0.0])?, estimate(found.shear)?))
+        Some((estimates([0.0, 0.0])?, estimates(found.shear)?))
     } else {
         None
     };
+    let ratio = check.as_ref().and_then(|(b, a)| paired_ratio(b, a));
     let verdict = check
         .as_ref()
         .filter(|_| found.shear != [0.0, 0.0])
-        .map(|(before, after)| CheckVerdict::of(before, after));
+        .map(|_| CheckVerdict::of(ratio.as_ref()));
+    let check = check.map(|(b, a)| (EmpiricalEstimate::of(&b), EmpiricalEstimate::of(&a)));
     let analytic = f.light_field().map(|l| l.layer_shears());
     let plane = |p: &PlaneDirections| {
         json!({"principal_slope": p.principal, "eigenvalue_ratio": p.eigenvalue_ratio,
@@ -257,6 +265,7 @@ pub fn search_and_check(
                         "b_minus": found.sensitivity[2], "b_plus": found.sensitivity[3]},
         "variance_before": check.as_ref().map(|c| ci(&c.0)),
         "variance_after": check.as_ref().map(|c| ci(&c.1)),
+        "check_ratio": ratio.map(|r| json!({"ratio": r.ratio, "ci_low": r.ci_low, "ci_high": r.ci_high})),
         "check_verdict": verdict.map(CheckVerdict::name),
         "reduction": (found.optimum.value > 0.0).then(|| found.unsheared.value / found.optimum.value),
         "range": range, "warnings": warnings,
@@ -266,6 +275,7 @@ pub fn search_and_check(
         found,
         spectral,
         check,
+        ratio,
         verdict,
         search_seconds,
         warnings,
@@ -277,35 +287,21 @@ pub fn search_and_check(
 mod tests {
     use super::*;
 
-    fn interval(ci_low: f64, ci_high: f64) -> EmpiricalEstimate {
-        EmpiricalEstimate {
-            variance: 0.5 * (ci_low + ci_high),
-            stderr: 0.25 * (ci_high - ci_low),
+    fn interval(ci_low: f64, ci_high: f64) -> VarianceRatio {
+        VarianceRatio {
+            ratio: (ci_low * ci_high).sqrt(),
             ci_low,
             ci_high,
-            mean: 0.0,
-            realizations: 100,
         }
     }
 
     #[test]
-    fn the_verdict_needs_the_intervals_apart() {
-        let before = interval(2.0, 3.0);
-        assert_eq!(
-            CheckVerdict::of(&before, &interval(1.0, 1.9)),
-            CheckVerdict::Confirms
-        );
-        assert_eq!(
-            CheckVerdict::of(&before, &interval(1.0, 2.1)),
-            CheckVerdict::Inconclusive
-        );
-        assert_eq!(
-            CheckVerdict::of(&before, &interval(2.9, 4.0)),
-            CheckVerdict::Inconclusive
-        );
-        assert_eq!(
-            CheckVerdict::of(&before, &interval(3.1, 4.0)),
-            CheckVerdict::Contradicts
-        );
+    fn the_verdict_needs_the_ratio_s_interval_off_one() {
+        let of = |lo, hi| CheckVerdict::of(Some(&interval(lo, hi)));
+        assert_eq!(of(0.5, 0.99), CheckVerdict::Confirms);
+        assert_eq!(of(0.5, 1.01), CheckVerdict::Inconclusive);
+        assert_eq!(of(0.99, 2.0), CheckVerdict::Inconclusive);
+        assert_eq!(of(1.01, 2.0), CheckVerdict::Contradicts);
+        assert_eq!(CheckVerdict::of(None), CheckVerdict::Inconclusive);
     }
 }
