@@ -229,7 +229,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 let e = sampler_variance(f.as_ref(), count, form, |r| {
                     source.get(r).map_err(|e| realization_error(r, e))
                 })?;
-                if e.rounding_bound > 0.0 && e.variance <= e.rounding_bound {
+                if varspec::variance::zero_to_rounding(e.variance, e.rounding_bound) {
                     bail!(
                         "N = {n}: the variance {:e} is at or below the {} form's rounding bound \
                          {:e}: it is zero to rounding ({label} integrates {name} to machine precision \

@@ -9,7 +9,7 @@ use super::run::{Cell, Shard};
 use super::spec::{Experiment, ExperimentError};
 use crate::integrands;
 use crate::io::write_atomic;
-use crate::variance::{SlopeFit, fit_slope, theoretical_rate};
+use crate::variance::{SlopeFit, fit_slope, theoretical_rate, zero_to_rounding};
 
 /// Writes the tables into `out` and returns the README's text.
 ///
@@ -145,13 +145,13 @@ pub fn write_results(
                         } else {
                             String::new()
                         };
-                        if c.rounding_bound > 0.0 && c.variance <= c.rounding_bound {
+                        if zero_to_rounding(c.variance, c.rounding_bound) {
                             return format!("0 to rounding (≤ {:.0e}){mark}{n}", c.rounding_bound);
                         }
                         // Sets that all give one variance (a lattice's is
                         // the same at every offset) differ by rounding only.
                         let err = c.stderr.map_or("± unknown (1 set)".into(), |s| {
-                            if c.rounding_bound > 0.0 && s <= c.rounding_bound {
+                            if zero_to_rounding(s, c.rounding_bound) {
                                 "± 0 to rounding".into()
                             } else {
                                 format!("± {s:.1e}")
@@ -178,9 +178,7 @@ pub fn write_results(
                     match cell.and_then(|c| c.radial.map(|r| (c, r))) {
                         // No relative error against a reference that is
                         // rounding noise.
-                        Some((c, _))
-                            if c.rounding_bound > 0.0 && c.variance <= c.rounding_bound =>
-                        {
+                        Some((c, _)) if zero_to_rounding(c.variance, c.rounding_bound) => {
                             "reference 0 to rounding".into()
                         }
                         Some((c, r)) => format!("{:+.2}", r.variance / c.variance - 1.0),
@@ -208,7 +206,7 @@ pub fn write_results(
         // A variance zero to rounding has no logarithm worth fitting.
         let fit = |s: usize, i: usize| {
             fit_of(s, i, &|c| {
-                (c.rounding_bound == 0.0 || c.variance > c.rounding_bound).then_some(c.variance)
+                (!zero_to_rounding(c.variance, c.rounding_bound)).then_some(c.variance)
             })
         };
         let radial_fit = |s: usize, i: usize| fit_of(s, i, &|c| c.radial.map(|r| r.variance));

@@ -236,10 +236,13 @@ where
         })
         .map(|idx| (spectrum.power[idx] - 1.0, pf[idx]))
         .collect();
+    // Σ √(N·P_S)·P_f for the rounding bound, in the same pass.
+    let mut root_weighted = NeumaierSum::default();
     for (idx, (&p, &w)) in spectrum.power.iter().zip(&pf).enumerate() {
         if idx != zero {
             in_box.add(p * w);
             mass.add(w);
+            root_weighted.add(p.max(0.0).sqrt() * w);
         }
     }
     let nf = intensity;
@@ -282,16 +285,12 @@ where
     let rounding_bound = {
         let largest = counts.iter().copied().max().unwrap_or(0) as f64;
         let e = tolerance * largest;
-        let mut transform = NeumaierSum::default();
-        for (idx, (&p, &w)) in spectrum.power.iter().zip(&pf).enumerate() {
-            if idx != zero {
-                let s = (p.max(0.0) * nf).sqrt();
-                transform.add((2.0 * s * e + e * e) / nf * w);
-            }
-        }
+        // Σ (2|S|·e + e²)/N·P_f with |S| = √(N·P_S·N): the two sums the box
+        // pass gathered.
+        let transform = (2.0 * e * root_weighted.value() * nf.sqrt() + e * e * mass.value()) / nf;
         let integral = f.integral();
         let sums = f.variance().abs() + integral * integral + mass.value() + in_box.value();
-        (transform.value() + 4.0 * f64::EPSILON * sums) / nf
+        (transform + 4.0 * f64::EPSILON * sums) / nf
     };
     let in_box = in_box.value() / nf;
     let tail = tail_mass / nf;

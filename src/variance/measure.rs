@@ -43,6 +43,12 @@ pub struct SamplerVariance {
     pub method: &'static str,
 }
 
+/// Whether `value` (a variance, or its standard error) is zero to
+/// rounding: at or below a positive rounding bound (0 means no bound).
+pub fn zero_to_rounding(value: f64, rounding_bound: f64) -> bool {
+    rounding_bound > 0.0 && value <= rounding_bound
+}
+
 /// The Fourier box half-width used for `dim`-dimensional integrands.
 pub fn fourier_half(dim: usize) -> usize {
     match dim {

@@ -22,7 +22,9 @@ pub use empirical::{
     shifted_estimates,
 };
 pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_parts};
-pub use measure::{SamplerVariance, VarianceForm, fourier_half, sampler_variance};
+pub use measure::{
+    SamplerVariance, VarianceForm, fourier_half, sampler_variance, zero_to_rounding,
+};
 pub use paired::{VarianceRatio, paired_ratio};
 pub use radial::{RadialEstimate, radial_from};
 pub use spatial::{SpatialEstimate, spatial, spatial_variance};
