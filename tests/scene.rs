@@ -933,3 +933,81 @@ fn the_smallest_warp_keeps_the_lens_coordinate_uniform() {
         );
     }
 }
+
+/// Configuration factor from a point to a parallel disk of radius `r` at
+/// height `h` whose axis passes `a` from the point (Howell's catalogue of
+/// configuration factors, B-13: F = ½[1 − (h² + a² − r²)/√((h² + a² + r²)² − 4a²r²)]).
+fn disk_factor(h: f64, a: f64, r: f64) -> f64 {
+    let (h2, a2, r2) = (h * h, a * a, r * r);
+    0.5 * (1.0 - (h2 + a2 - r2) / ((h2 + a2 + r2).powi(2) - 4.0 * a2 * r2).sqrt())
+}
+
+/// Configuration factor from a point to a parallel `x` × `y` rectangle at
+/// height `h` with one corner straight above it (Howell, B-3).
+fn corner_rectangle_factor(h: f64, x: f64, y: f64) -> f64 {
+    let (x, y) = (x / h, y / h);
+    let (sx, sy) = ((1.0 + x * x).sqrt(), (1.0 + y * y).sqrt());
+    (x / sx * (y / sx).atan() + y / sy * (x / sy).atan()) / (2.0 * std::f64::consts::PI)
+}
+
+/// Soft shadows in absolute units: a pinhole camera looks straight down on
+/// a grey plane (albedo ρ) lit by one area light of radiance L parallel to
+/// it at height h. The centre pixel's radiance is ρ·L·F, F the point's
+/// configuration factor to the light, in closed form for a disk (on the
+/// axis and off it) and a square; the footprint is 0.035 wide, so F's
+/// curvature across it shifts the pixel by < 1e-4 of its value. Tolerance:
+/// 4.5 standard errors of the mean over 64 renders (two-sided 7e-6 each;
+/// a 1% error in the light's normalization is 5–40 standard errors).
+#[test]
+fn soft_shadows_match_the_closed_form_irradiance_of_disk_and_square_lights() {
+    use varspec::scene::analysis::SampleShear;
+    use varspec::scene::render::render_variance;
+    let (albedo, radiance, h) = (0.5, 10.0, 1.0);
+    let cases = [
+        ("disk", 0.7, 0.0, disk_factor(h, 0.0, 0.35)),
+        ("disk", 0.7, 0.6, disk_factor(h, 0.6, 0.35)),
+        ("disk", 1.0, 1.5, disk_factor(h, 1.5, 0.5)),
+        (
+            "square",
+            0.8,
+            0.0,
+            4.0 * corner_rectangle_factor(h, 0.4, 0.4),
+        ),
+    ];
+    let sampler = registry::build("random", 1024, Some(4), &[]).unwrap();
+    for (shape, size, offset, factor) in cases {
+        let text = format!(
+            r#"{{"camera": {{"resolution": [5, 5], "fov_degrees": 2, "position": [0, 0, 0],
+                 "look_at": [0, 0, -1], "focal_distance": 5, "aperture": 0}},
+               "integrand": "light", "ambient": 0.0,
+               "objects": [{{"shape": "quad", "scale": [20, 20, 1], "translate": [0, 0, -5],
+                             "material": {{"texture": "constant", "albedo": {albedo}}}}}],
+               "lights": [{{"shape": "{shape}", "centre": [{offset}, 0, {z}], "normal": [0, 0, -1],
+                            "size": {size}, "radiance": {radiance}}}]}}"#,
+            z = -5.0 + h
+        );
+        let scene = Scene::from_text(&text, shape).unwrap();
+        let maps = render_variance(
+            &scene,
+            sampler.as_ref(),
+            &[SampleShear::NONE; 25],
+            11,
+            64,
+            &|| {},
+        )
+        .unwrap();
+        let (mean, se) = (
+            maps.mean.pixels[12],
+            (maps.variance.pixels[12] / 64.0).sqrt(),
+        );
+        let expected = albedo * radiance * factor;
+        assert!(
+            (mean - expected).abs() <= 4.5 * se,
+            "{shape} of size {size} offset {offset}: pixel {mean:.6} ± {se:.2e}, closed form {expected:.6} (F = {factor:.6})"
+        );
+        assert!(
+            se < 0.01 * expected,
+            "{shape}: standard error {se:.2e} too wide to test {expected:.4}"
+        );
+    }
+}
