@@ -285,7 +285,7 @@ where
     let rounding_bound = {
         let largest = counts.iter().copied().max().unwrap_or(0) as f64;
         let e = tolerance * largest;
-        // Σ (2|S|·e + e²)/N·P_f with |S| = √(N·P_S·N): the two sums the box
+        // Σ (2|S|·e + e²)/N·P_f with |S| = √(N·P_S): the two sums the box
         // pass gathered.
         let transform = (2.0 * e * root_weighted.value() * nf.sqrt() + e * e * mass.value()) / nf;
         let integral = f.integral();
