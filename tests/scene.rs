@@ -662,6 +662,45 @@ fn a_pixel_as_an_integrand_has_its_closed_form_integral_and_variance() {
     assert_eq!(f.spec(), "scene:edge,px=4,py=4");
 }
 
+/// A pixel's estimated integral comes with a standard error (the spread
+/// of independent sets' means): over 40 pixels crossed by the edge (each
+/// pixel draws its own reference sets), the closed form's
+/// z = (I ≈ − I)/se are independent Student t with 15 degrees of freedom,
+/// so the mean of the 40 z² lies in [0.45, 2.50] with probability 99.9%
+/// (its 0.05% and 99.95% quantiles, from 4·10^5 simulated means). An error
+/// bar half the true one puts that mean above 2.4, twice it below 0.5, in
+/// 99% of cases.
+#[test]
+fn a_pixel_integral_s_standard_error_covers_the_closed_form() {
+    use std::sync::Arc;
+    use varspec::integrands::Integrand;
+    use varspec::scene::pixel::PixelIntegrand;
+    let (depth, focus, aperture) = (6.0, 3.0, 0.3);
+    let mut squares = Vec::new();
+    for px in 2..=6 {
+        // Pixel px's footprint on the plane spans X from c − 0.6 to
+        // c + 0.402: one edge position per row across it.
+        let c = (px as f64 - 4.0) * 0.402 + 0.3;
+        for py in 0..8 {
+            let edge = c - 0.58 + 0.96 * (py as f64 + 0.5) / 8.0;
+            let scene = Arc::new(edge_scene(depth, focus, aperture, edge));
+            let f = PixelIntegrand::new(scene, px, py);
+            let truth = edge_pixel(depth, focus, aperture, edge, px);
+            assert!(
+                truth > 0.0 && truth < 1.0 && f.integral_stderr() > 0.0,
+                "pixel ({px}, {py}), edge {edge}: I = {truth}, se {}",
+                f.integral_stderr()
+            );
+            squares.push(((f.integral() - truth) / f.integral_stderr()).powi(2));
+        }
+    }
+    let mean = squares.iter().sum::<f64>() / squares.len() as f64;
+    assert!(
+        (0.45..=2.50).contains(&mean),
+        "mean z² {mean:.3} outside the 99.9% range [0.45, 2.50] of t²(15): {squares:.2?}"
+    );
+}
+
 #[test]
 fn the_pixel_shear_search_picks_the_warp_of_a_defocused_edge_and_sees_double_wedges() {
     use std::sync::Arc;

@@ -388,7 +388,8 @@ fn a_warp_of_slope_zero_is_no_shear() {
 /// field of view scaled by 32/256) on the defocused checker; the render's
 /// variance is from 3000 renders through the library, its standard error
 /// from their fourth central moment; the two agree within 4 combined
-/// standard errors (a two-sided 99.99% band, about ±16%).
+/// standard errors (a two-sided 99.99% band, about ±16%). Its estimated
+/// integral agrees with the renders' mean within the same band.
 #[test]
 fn predict_on_a_pixel_gives_the_variance_its_render_measures() {
     use varspec::scene::Scene;
@@ -452,6 +453,17 @@ fn predict_on_a_pixel_gives_the_variance_its_render_measures() {
         (predicted - rendered).abs() <= band,
         "pixel {spec}: predicted {predicted:e} ± {predicted_se:e}, rendered {rendered:e} ± \
          {rendered_se:e} (99.99% band ±{band:e})"
+    );
+    // The pixel's estimated integral, with its standard error, against the
+    // renders' mean: the same 99.99% band.
+    let integral = report["integral"].as_f64().unwrap();
+    let integral_se = report["integral_stderr"].as_f64().unwrap();
+    let mean_se = (rendered / r).sqrt();
+    let band = 4.0 * integral_se.hypot(mean_se);
+    assert!(
+        integral_se > 0.0 && (integral - mean).abs() <= band,
+        "pixel {spec}: I ≈ {integral} ± {integral_se:e}, the renders' mean {mean} ± {mean_se:e} \
+         (99.99% band ±{band:e})"
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -126,16 +126,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // A scene pixel has no closed form: only the empirical predictor,
     // which evaluates f, applies (`--method all` runs it alone).
     let pixel = PixelIntegrand::is_pixel_spec(spec);
-    let f: Box<dyn Integrand> = if pixel {
+    // A pixel's integral is an estimate: its standard error goes with it.
+    let (f, integral_stderr): (Box<dyn Integrand>, Option<f64>) = if pixel {
         if !matches!(a.method, MethodArg::Empirical | MethodArg::All) {
             bail!(
                 "{spec}: a scene pixel has no closed-form spectrum or autocovariance; \
                  predict it with --method empirical"
             );
         }
-        Box::new(PixelIntegrand::parse(spec)?)
+        let f = PixelIntegrand::parse(spec)?;
+        let stderr = f.integral_stderr();
+        (Box::new(f), Some(stderr))
     } else {
-        integrands::parse(spec)?
+        (integrands::parse(spec)?, None)
     };
     // Options of a predictor that will not run are refused, not ignored.
     let fourier_runs = !pixel
@@ -226,11 +229,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     out.insert("n".into(), json!(n));
     out.insert("density".into(), json!(source.density()));
     out.insert("integral".into(), json!(f.integral()));
-    if pixel {
+    if let Some(stderr) = integral_stderr {
+        out.insert("integral_stderr".into(), json!(stderr));
         out.insert(
             "integral_note".into(),
             json!(format!(
-                "estimated from {} multi-jittered samples (a pixel has no closed form)",
+                "estimated from {} independent multi-jittered sets of {} samples, with the \
+                 standard error of their mean (a pixel has no closed form)",
+                varspec::scene::pixel::REFERENCE_SETS,
                 varspec::scene::pixel::REFERENCE_POINTS
             )),
         );
@@ -327,13 +333,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     } else {
         super::stdout::counted(sets, "set")
     };
+    // An estimate is printed to the digit its standard error reaches.
+    let integral = match integral_stderr {
+        Some(stderr) if stderr > 0.0 => {
+            let digits = (1.0 - stderr.log10().floor()).clamp(0.0, 17.0) as usize;
+            format!("≈ {:.digits$} (standard error {stderr:.1e})", f.integral())
+        }
+        Some(_) => format!(
+            "≈ {} (the same on every reference sample)",
+            varspec::spec_params::SpecValue(f.integral())
+        ),
+        None => format!("= {}", varspec::spec_params::SpecValue(f.integral())),
+    };
     outln!(
-        "{} on {} ({}, {drawn_label}), I {} {}",
+        "{} on {} ({}, {drawn_label}), I {integral}",
         f.spec(),
         source.name(),
         source.count_label(),
-        if pixel { "≈" } else { "=" },
-        varspec::spec_params::SpecValue(f.integral())
     );
     if shift != ShiftArg::All {
         outln!("  estimator: {}", shift.estimator());
