@@ -210,12 +210,55 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
             "\"subdivisions\": \"four\"",
             "objects[2].subdivisions: invalid type: string \"four\"",
         ),
+        // A material's fields are read flat so that a wrong type names the
+        // field itself, not only the material (serde's tagged enums lose it).
+        (
+            "\"low\": 0.15",
+            "\"low\": \"0.15\"",
+            "objects[0].material.low: invalid type: string \"0.15\"",
+        ),
+        (
+            "\"low\": 0.15",
+            "\"albedo\": 0.5, \"low\": 0.15",
+            "objects[0].material: `albedo` is not a field of a `checker` texture (its fields: period, low, high)",
+        ),
+        (
+            "\"low\": 0.15, ",
+            "",
+            "objects[0].material: missing field `low` of a `checker` texture",
+        ),
+        (
+            "\"resolution\": [256, 256]",
+            "\"resolution\": [256, 256, 3]",
+            "camera.resolution: more elements than this array takes at line",
+        ),
+        (
+            "\"aperture\": 0.06",
+            "\"aperture\": NaN",
+            "camera.aperture: `NaN` is not a JSON value (JSON has no NaN or infinities",
+        ),
+        (
+            "\"aperture\": 0.06",
+            "\"aperture\": -Infinity",
+            "camera.aperture: `-Infinity` is not a JSON value (JSON has no NaN or infinities",
+        ),
     ];
     for (from, to, phrase) in cases {
         assert!(base.contains(from), "{from}");
         let path = dir.join("bad.json");
         std::fs::write(&path, base.replacen(from, to, 1)).unwrap();
         assert_fails(&["render", path.to_str().unwrap(), "--spp", "4"], phrase);
+    }
+    // The top level is one object: serde would read an array as the
+    // struct's fields in order and blame the first element.
+    for (text, phrase) in [
+        (format!("[{base}]"), "a JSON array, where one JSON object"),
+        ("3".to_string(), "`3` at the top, where one JSON object"),
+        (" \n".to_string(), "empty, where one JSON object"),
+    ] {
+        let path = dir.join("top.json");
+        std::fs::write(&path, text).unwrap();
+        assert_fails(&["render", path.to_str().unwrap()], phrase);
     }
     assert_fails(&["render", "nosuchscene"], "neither a built-in scene (dof,");
     assert_fails(

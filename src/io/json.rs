@@ -9,21 +9,102 @@
 
 use serde::de::DeserializeOwned;
 
-/// Parses `text` as a `T`.
+/// Parses `text` as a `T`, a struct written as one JSON object.
 ///
 /// # Errors
 /// serde_json's message, prefixed with the path of the offending field
-/// (`camera.resolution[0]`) when it lies below the top level.
+/// (`camera.resolution[0]`) when it lies below the top level, and made
+/// plainer where serde_json's words mislead a person writing the file: a
+/// top-level array (which serde would read as the struct's fields in
+/// order), an array longer than its field takes ("trailing characters"),
+/// and a value that is not JSON ("expected value"), named with `NaN` and
+/// `Infinity` called out, which JSON does not have.
 pub fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, String> {
+    const OBJECT: &str = "one JSON object ({ \"field\": value, ... })";
+    let start = text.trim_start();
+    match start.chars().next() {
+        Some('{') => {}
+        None => return Err(format!("empty, where {OBJECT} is expected")),
+        Some('[') => return Err(format!("a JSON array, where {OBJECT} is expected")),
+        Some(_) => {
+            let found = start.split_whitespace().next().unwrap_or_default();
+            let found: String = found.chars().take(24).collect();
+            return Err(format!("`{found}` at the top, where {OBJECT} is expected"));
+        }
+    }
     let mut de = serde_json::Deserializer::from_str(text);
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
+        let message = plain_message(e.inner(), text);
         if path == "." {
-            e.inner().to_string()
+            message
         } else {
-            format!("{path}: {}", e.inner())
+            format!("{path}: {message}")
         }
     })?;
     de.end().map_err(|e| e.to_string())?;
     Ok(value)
+}
+
+/// serde_json's message for an error below the top level, in a file
+/// writer's words where serde_json's own mislead.
+fn plain_message(e: &serde_json::Error, text: &str) -> String {
+    let at = format!("at line {} column {}", e.line(), e.column());
+    let message = e.to_string();
+    if message.starts_with("trailing characters") {
+        // Inside a value, serde_json says this of a fixed-length array
+        // given more elements than it takes.
+        return format!("more elements than this array takes {at}");
+    }
+    if message.starts_with("expected value") || message.starts_with("invalid number") {
+        let found = token_at(text, e.line(), e.column());
+        if found.is_empty() {
+            return message;
+        }
+        let bare = found.trim_start_matches(['+', '-']).to_ascii_lowercase();
+        let hint = if ["nan", "inf", "infinity"].contains(&bare.as_str()) {
+            " (JSON has no NaN or infinities: give a finite number)"
+        } else {
+            ""
+        };
+        return format!("`{found}` is not a JSON value{hint} {at}");
+    }
+    message
+}
+
+/// The word around 1-based `line` and `column` of `text` (letters,
+/// digits, signs and dots), empty if there is none.
+fn token_at(text: &str, line: usize, column: usize) -> &str {
+    let part = |c: char| c.is_alphanumeric() || matches!(c, '+' | '-' | '.');
+    let Some(row) = text.lines().nth(line.saturating_sub(1)) else {
+        return "";
+    };
+    let Some((before, after)) = row.split_at_checked(column.saturating_sub(1).min(row.len()))
+    else {
+        return "";
+    };
+    let start = before.rfind(|c: char| !part(c)).map_or(0, |i| i + 1);
+    let end = after.find(|c: char| !part(c)).unwrap_or(after.len());
+    &row[start..before.len() + end]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::token_at;
+
+    #[test]
+    fn the_word_around_an_error_s_column_is_found_whole() {
+        let text = "{\n  \"a\": -Infinity,\n  \"é\": NaN }";
+        // serde_json points at the sign's successor for an invalid number
+        // and at the first letter for a value it does not know.
+        assert_eq!(token_at(text, 2, 9), "-Infinity");
+        assert_eq!(token_at(text, 2, 8), "-Infinity");
+        // Columns count bytes: "é" is two, so NaN starts at byte 9.
+        assert_eq!(token_at(text, 3, 9), "NaN");
+        // Inside a multi-byte character, past the end, or on a missing
+        // line: nothing, never a panic.
+        assert_eq!(token_at(text, 3, 5), "");
+        assert_eq!(token_at(text, 2, 400), "");
+        assert_eq!(token_at(text, 9, 1), "");
+    }
 }

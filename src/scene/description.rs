@@ -113,7 +113,7 @@ pub enum ShapeKind {
 /// object's frame (its translation and rotation, world units: scaling the
 /// object does not stretch the texture), so its bandwidth is known.
 #[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields, tag = "texture", rename_all = "snake_case")]
+#[serde(try_from = "MaterialFields")]
 pub enum MaterialFile {
     /// One albedo.
     Constant {
@@ -138,6 +138,80 @@ pub enum MaterialFile {
         /// Albedo of the light stripes.
         high: f64,
     },
+}
+
+/// A material as written: the texture's name and every field any texture
+/// takes. Read flat rather than as a tagged enum so that a field of the
+/// wrong type is named by its path (`objects[0].material.albedo`), which
+/// serde's internally tagged enums lose; [`MaterialFile::try_from`] then
+/// checks that the fields are the texture's own.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialFields {
+    texture: TextureKind,
+    albedo: Option<f64>,
+    period: Option<f64>,
+    low: Option<f64>,
+    high: Option<f64>,
+}
+
+/// The `texture` of a material.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum TextureKind {
+    Constant,
+    Checker,
+    Stripes,
+}
+
+impl TryFrom<MaterialFields> for MaterialFile {
+    type Error = String;
+
+    /// The texture's fields, each present; a field of another texture is
+    /// refused by name with the texture's own fields.
+    fn try_from(m: MaterialFields) -> Result<MaterialFile, String> {
+        use TextureKind::{Checker, Constant, Stripes};
+        match (m.texture, m.albedo, m.period, m.low, m.high) {
+            (Constant, Some(albedo), None, None, None) => Ok(MaterialFile::Constant { albedo }),
+            (Checker, None, Some(period), Some(low), Some(high)) => {
+                Ok(MaterialFile::Checker { period, low, high })
+            }
+            (Stripes, None, Some(period), Some(low), Some(high)) => {
+                Ok(MaterialFile::Stripes { period, low, high })
+            }
+            _ => Err(m.mismatch()),
+        }
+    }
+}
+
+impl MaterialFields {
+    /// The first field that is not the texture's own, or the first of its
+    /// own that is missing, named with the texture's fields.
+    fn mismatch(&self) -> String {
+        let (name, own): (&str, &[&str]) = match self.texture {
+            TextureKind::Constant => ("constant", &["albedo"]),
+            TextureKind::Checker => ("checker", &["period", "low", "high"]),
+            TextureKind::Stripes => ("stripes", &["period", "low", "high"]),
+        };
+        let given = [
+            ("albedo", self.albedo.is_some()),
+            ("period", self.period.is_some()),
+            ("low", self.low.is_some()),
+            ("high", self.high.is_some()),
+        ];
+        let foreign = given.iter().find(|&&(f, set)| set && !own.contains(&f));
+        let missing = given.iter().find(|&&(f, set)| !set && own.contains(&f));
+        let own = own.join(", ");
+        match (foreign, missing) {
+            (Some((field, _)), _) => {
+                format!("`{field}` is not a field of a `{name}` texture (its fields: {own})")
+            }
+            (None, Some((field, _))) => {
+                format!("missing field `{field}` of a `{name}` texture (its fields: {own})")
+            }
+            (None, None) => format!("a `{name}` texture takes the fields {own}"),
+        }
+    }
 }
 
 /// An emitting square or disk, one-sided, facing `normal`.
