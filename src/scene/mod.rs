@@ -319,6 +319,12 @@ impl Scene {
         let (point, normal) = (hit.point, hit.normal);
         let to = description::sub(at, point);
         let r2 = dot(to, to);
+        // A surface point on the light point itself: no direction to it
+        // (a light lying on a surface meets it at cos θ′ = 0 anyway); a
+        // set of measure zero, given 0 rather than a NaN pixel.
+        if r2 <= 0.0 {
+            return 0.0;
+        }
         let r = r2.sqrt();
         let dir = to.map(|c| c / r);
         let cos_surface = dot(normal, dir);
@@ -361,5 +367,42 @@ impl Scene {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_surface_point_on_the_light_point_gets_no_light_not_nan() {
+        let scene = Scene::from_text(
+            r#"{"camera": {"resolution": [1, 1], "fov_degrees": 30, "position": [0, 0, 0],
+                           "look_at": [0, 0, -1], "focal_distance": 1, "aperture": 0},
+                "integrand": "light",
+                "objects": [{"shape": "quad", "translate": [0, 0, -5],
+                             "material": {"texture": "constant", "albedo": 0.5}}],
+                "lights": [{"shape": "disk", "size": 0.2, "centre": [0, 0, -4],
+                            "normal": [0, 0, -1], "radiance": 1}]}"#,
+            "t",
+        )
+        .unwrap();
+        let light = &scene.lights[0];
+        let on = |point| Hit {
+            t: 1.0,
+            point,
+            normal: [0.0, 0.0, 1.0],
+            object: 0,
+        };
+        assert_eq!(
+            scene.direct(light, light.centre, &on(light.centre), 5.0),
+            0.0
+        );
+        // One unit below, straight under it: L_e/π.
+        let below = scene.direct(light, light.centre, &on([0.0, 0.0, -5.0]), 5.0);
+        assert!(
+            (below - 1.0 / std::f64::consts::PI).abs() < 1e-12,
+            "{below}"
+        );
     }
 }
