@@ -57,6 +57,11 @@ fn output_file_matches_stdout_and_reads_back() {
         path.to_str().unwrap(),
     ]);
     assert!(file_run.status.success());
+    // A file written is confirmed with what it holds.
+    assert_eq!(
+        String::from_utf8_lossy(&file_run.stdout),
+        format!("wrote {}: 3 sets of jitter N=16 in 2D\n", path.display())
+    );
     let stdout_run = varspec(&["sample", "jitter", "-n", "16", "--sets", "3"]);
     assert_eq!(std::fs::read(&path).unwrap(), stdout_run.stdout);
     let sets = varspec::io::read_point_sets(&path).unwrap();
@@ -509,6 +514,14 @@ fn plot_draws_a_projection_and_reports_bad_files_by_line() {
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout),
+        format!(
+            "wrote {}: set 0 of {}, dimensions 0 and 2\n",
+            png.display(),
+            points.display()
+        )
     );
     let img = image::open(&png).unwrap();
     assert_eq!((img.width(), img.height()), (512, 512));

@@ -136,5 +136,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         line_plot_png(&plot, path)?;
     }
+    let written: Vec<String> = [&a.csv, &a.png]
+        .into_iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
+    if !written.is_empty() {
+        outln!("wrote {}", written.join(", "));
+    }
     Ok(())
 }

@@ -57,5 +57,13 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     let img = render_points(set, [dims[0], dims[1]], a.size)
         .with_context(|| format!("{}", a.file.display()))?;
     save_png(&img, &a.output)?;
+    outln!(
+        "wrote {}: set {} of {}, dimensions {} and {}",
+        a.output.display(),
+        a.set,
+        a.file.display(),
+        dims[0],
+        dims[1]
+    );
     Ok(())
 }

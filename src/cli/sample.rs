@@ -100,7 +100,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let format = Format::resolve(a.format, a.output.as_deref());
     match &a.output {
-        Some(path) => write_atomic(path, |w| format.write(w, &sets))?,
+        Some(path) => {
+            write_atomic(path, |w| format.write(w, &sets))?;
+            let dim = sets.first().map_or(0, |s| s.dim());
+            outln!(
+                "wrote {}: {} of {name} N={n} in {dim}D",
+                path.display(),
+                super::stdout::counted(sets.len(), "set")
+            );
+        }
         None => {
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
             format

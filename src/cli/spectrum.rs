@@ -244,14 +244,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         line_plot_png(&plot, path)?;
     }
-    if a.csv.is_none()
-        && a.npy.is_none()
-        && a.radial.is_none()
-        && a.png.is_none()
-        && a.radial_png.is_none()
-    {
+    let written: Vec<String> = [&a.csv, &a.npy, &a.radial, &a.png, &a.radial_png]
+        .into_iter()
+        .flatten()
+        .map(|p| p.display().to_string())
+        .collect();
+    if written.is_empty() {
         let mut out = std::io::stdout().lock();
         radial_csv(&mut out)?;
+    } else {
+        outln!("wrote {}", written.join(", "));
     }
     Ok(())
 }
