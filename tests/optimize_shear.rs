@@ -566,3 +566,82 @@ fn the_search_widens_its_range_warns_and_handles_degenerate_integrands() {
         "[0.0,0.0]"
     );
 }
+
+/// `-o` writes the `--sets` sets `sample` draws with the same seed, each
+/// sheared by the reported shear (x′ = x + a·u, y′ = y + b·v mod 1);
+/// `--png-prefix` their XU and YV spectra before and after; the text
+/// output names every file written.
+#[test]
+fn the_written_sets_are_the_seeded_sets_sheared_by_the_found_shear() {
+    let dir = crate::common::temp_dir("shear-outputs");
+    let (sheared, drawn) = (dir.join("sheared.csv"), dir.join("drawn.csv"));
+    let prefix = dir.join("p");
+    let spec = "defocus:shape=disk,size=0.3,c=0.5";
+    let common = [
+        "-n",
+        "64",
+        "--sets",
+        "3",
+        "--seed",
+        "11",
+        "--integrand",
+        spec,
+        "-o",
+        sheared.to_str().unwrap(),
+        "--png-prefix",
+        prefix.to_str().unwrap(),
+    ];
+    let json = crate::common::varspec_ok(&[&["optimize", "shear", "--json"][..], &common].concat());
+    let report: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let [a, b] = [0, 1].map(|i| report["shear"][i].as_f64().unwrap());
+    assert!(
+        a < -0.3 && b < -0.3,
+        "the shear of c = 0.5 is near −0.5: {a}, {b}"
+    );
+    crate::common::varspec_ok(&[
+        "sample",
+        "umj",
+        "-n",
+        "64",
+        "--sets",
+        "3",
+        "--seed",
+        "11",
+        "-o",
+        drawn.to_str().unwrap(),
+    ]);
+    let (after, before) = (
+        varspec::io::read_point_sets(&sheared).unwrap(),
+        varspec::io::read_point_sets(&drawn).unwrap(),
+    );
+    assert_eq!((after.len(), after[0].len(), after[0].dim()), (3, 64, 4));
+    for (s, d) in after.iter().zip(&before) {
+        for (p, q) in s.points().zip(d.points()) {
+            let x = (q[0] + a * q[2]).rem_euclid(1.0);
+            let y = (q[1] + b * q[3]).rem_euclid(1.0);
+            assert!(
+                (p[0] - x).abs() < 1e-12 && (p[1] - y).abs() < 1e-12 && p[2..] == q[2..],
+                "{p:?} is not {q:?} sheared by ({a}, {b})"
+            );
+        }
+    }
+    let pictures: Vec<String> = ["xu-before", "xu-after", "yv-before", "yv-after"]
+        .iter()
+        .map(|name| format!("{}-{name}.png", prefix.display()))
+        .collect();
+    for png in &pictures {
+        assert!(std::fs::read(png).unwrap().starts_with(b"\x89PNG"), "{png}");
+    }
+    // The text output ends by naming them all.
+    let text = crate::common::varspec_ok(&[&["optimize", "shear"][..], &common].concat());
+    let last = String::from_utf8_lossy(&text.stdout)
+        .lines()
+        .last()
+        .unwrap_or_default()
+        .to_string();
+    assert_eq!(
+        last,
+        format!("wrote {}, {}", sheared.display(), pictures.join(", "))
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -161,9 +161,26 @@ fn the_projection_report_counts_each_sets_iterations() {
         dir.join("d.csv").to_str().unwrap(),
         "--report",
         report.to_str().unwrap(),
+        "--curve",
+        dir.join("c.csv").to_str().unwrap(),
+        "--curve-png",
+        dir.join("c.png").to_str().unwrap(),
     ]);
     let r = crate::common::read_json(&report);
     assert_eq!(r["iterations"], serde_json::json!([7, 7]), "{r}");
     assert_eq!(r["max_iterations"], 7);
+    // The loss curve options are honoured here too (they were ignored by
+    // 4D projection designs): the CSV holds set 0's curve of the report.
+    let csv = std::fs::read_to_string(dir.join("c.csv")).unwrap();
+    assert_eq!(
+        csv.lines().count(),
+        1 + r["loss_curve"].as_array().unwrap().len(),
+        "{csv}"
+    );
+    assert!(
+        std::fs::read(dir.join("c.png"))
+            .unwrap()
+            .starts_with(b"\x89PNG")
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -329,10 +329,18 @@ fn command_line_designs_scores_and_labels_the_square() {
         sets.to_str().unwrap(),
         "--report",
         report.to_str().unwrap(),
+        "--curve-png",
+        dir.join("c.png").to_str().unwrap(),
     ]);
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert_eq!(r["domain"], "square");
+    // --curve-png is honoured on the square too (it was ignored).
+    assert!(
+        std::fs::read(dir.join("c.png"))
+            .unwrap()
+            .starts_with(b"\x89PNG")
+    );
     // 60 iterations hold fewer than the 51 scores the stopping rule needs.
     assert_eq!(r["stopped"], serde_json::json!(["cap", "cap"]));
     // Per set what ran (as the torus report), beside the cap.

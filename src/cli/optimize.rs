@@ -420,51 +420,25 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
             v["loss"].as_f64().unwrap_or(f64::NAN)
         );
     }
-    let curve: Vec<(f64, f64)> = design
-        .loss_curve_seconds
-        .iter()
-        .copied()
-        .zip(design.loss_curve.iter().copied())
-        .collect();
-    if let Some(path) = &a.curve {
-        write_loss_curve(path, curve.iter().copied())?;
-    }
-    if let Some(path) = &a.curve_png {
-        use varspec::report::plot::{LinePlot, Series, line_plot_png};
-        let (t0, t1) = (
-            curve
-                .iter()
-                .map(|c| c.0)
-                .fold(f64::INFINITY, f64::min)
-                .max(1e-4),
-            curve.last().map_or(1.0, |c| c.0),
-        );
-        let mut series = vec![Series {
-            label: "optimized (set 0)".into(),
-            points: curve.clone(),
-            reference: false,
-        }];
-        for b in &design.baselines {
-            series.push(Series {
-                label: b.name.into(),
-                points: vec![(t0, b.score), (t1, b.score)],
-                reference: true,
-            });
-        }
-        let plot = LinePlot {
-            title: format!("loss against time: {} N={}", a.target, a.n),
-            x_label: "seconds".into(),
-            y_label: "loss".into(),
-            log_log: true,
-            series,
-        };
-        line_plot_png(&plot, path)?;
-    }
+    let baselines: Vec<(&str, f64)> = design.baselines.iter().map(|b| (b.name, b.score)).collect();
+    loss_curve_outputs(
+        &a,
+        &format!("{} N={}", a.target, a.n),
+        &design.loss_curve_seconds,
+        &design.loss_curve,
+        &baselines,
+    )?;
     if let Some(path) = &a.report {
         write_atomic(path, |w| {
             w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
         })?;
     }
+    super::stdout::wrote(
+        std::iter::once(&a.output)
+            .chain(&a.curve)
+            .chain(&a.curve_png)
+            .chain(&a.report),
+    );
     Ok(())
 }
 
@@ -508,11 +482,24 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
         closest.xy,
         closest.uv
     );
+    loss_curve_outputs(
+        &a,
+        &format!("{} N={} in 4D", a.target, a.n),
+        &design.loss_curve_seconds,
+        &design.loss_curve,
+        &[],
+    )?;
     if let Some(path) = &a.report {
         write_atomic(path, |w| {
             w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
         })?;
     }
+    super::stdout::wrote(
+        std::iter::once(&a.output)
+            .chain(&a.curve)
+            .chain(&a.curve_png)
+            .chain(&a.report),
+    );
     Ok(())
 }
 
@@ -580,21 +567,24 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
                 .unwrap_or(f64::NAN)
         );
     }
-    if let Some(path) = &a.curve {
-        write_loss_curve(
-            path,
-            design
-                .loss_curve_seconds
-                .iter()
-                .copied()
-                .zip(design.loss_curve.iter().copied()),
-        )?;
-    }
+    loss_curve_outputs(
+        &a,
+        &format!("{} N={} on the square", a.target, a.n),
+        &design.loss_curve_seconds,
+        &design.loss_curve,
+        &[],
+    )?;
     if let Some(path) = &a.report {
         write_atomic(path, |w| {
             w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
         })?;
     }
+    super::stdout::wrote(
+        std::iter::once(&a.output)
+            .chain(&a.curve)
+            .chain(&a.curve_png)
+            .chain(&a.report),
+    );
     Ok(())
 }
 
@@ -660,6 +650,33 @@ fn sheared_outputs(
         )?;
     }
     Ok(())
+}
+
+/// Says which files `optimize shear` wrote: `-o` and the pictures of
+/// `--png-prefix` (a pixel's also its light field's), once its results
+/// are printed; JSON output stays one document.
+fn report_shear_outputs(a: &ShearArgs, pixel: bool) {
+    if a.json {
+        return;
+    }
+    let pictures = a.png_prefix.iter().flat_map(|prefix| {
+        PLANES.iter().flat_map(move |(name, _, _)| {
+            let light_field = pixel.then(|| format!("{prefix}-f-{name}.png"));
+            [
+                Some(format!("{prefix}-{name}-before.png")),
+                Some(format!("{prefix}-{name}-after.png")),
+                light_field,
+            ]
+            .into_iter()
+            .flatten()
+        })
+    });
+    super::stdout::wrote(
+        a.output
+            .iter()
+            .map(|p| p.display().to_string())
+            .chain(pictures),
+    );
 }
 
 /// `optimize shear` on a scene pixel: the candidates of its local analysis
@@ -761,6 +778,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
             "no lower".to_string()
         }
     );
+    report_shear_outputs(&a, true);
     Ok(())
 }
 
@@ -871,6 +889,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             );
         }
     }
+    report_shear_outputs(&a, false);
     for warning in &run.warnings {
         eprintln!("warning: {warning}");
     }
@@ -882,6 +901,53 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             "the check cannot tell the shear from none (the paired ratio's 95% interval holds 1): raise --realizations to separate them"
         ),
         _ => {}
+    }
+    Ok(())
+}
+
+/// `--curve` (CSV) and `--curve-png` (log-log against time, with the
+/// classic samplers' losses as flat references where the design has them)
+/// of set 0's loss curve.
+fn loss_curve_outputs(
+    a: &PointsArgs,
+    what: &str,
+    seconds: &[f64],
+    loss: &[f64],
+    baselines: &[(&str, f64)],
+) -> anyhow::Result<()> {
+    use varspec::report::plot::{LinePlot, Series, line_plot_png};
+    let curve: Vec<(f64, f64)> = seconds.iter().copied().zip(loss.iter().copied()).collect();
+    if let Some(path) = &a.curve {
+        write_loss_curve(path, curve.iter().copied())?;
+    }
+    if let Some(path) = &a.curve_png {
+        let (t0, t1) = (
+            curve
+                .iter()
+                .map(|c| c.0)
+                .fold(f64::INFINITY, f64::min)
+                .max(1e-4),
+            curve.last().map_or(1.0, |c| c.0),
+        );
+        let series = std::iter::once(Series {
+            label: "optimized (set 0)".into(),
+            points: curve.clone(),
+            reference: false,
+        })
+        .chain(baselines.iter().map(|&(name, score)| Series {
+            label: name.into(),
+            points: vec![(t0, score), (t1, score)],
+            reference: true,
+        }))
+        .collect();
+        let plot = LinePlot {
+            title: format!("loss against time: {what}"),
+            x_label: "seconds".into(),
+            y_label: "loss".into(),
+            log_log: true,
+            series,
+        };
+        line_plot_png(&plot, path)?;
     }
     Ok(())
 }

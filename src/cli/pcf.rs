@@ -136,13 +136,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         line_plot_png(&plot, path)?;
     }
-    let written: Vec<String> = [&a.csv, &a.png]
-        .into_iter()
-        .flatten()
-        .map(|p| p.display().to_string())
-        .collect();
-    if !written.is_empty() {
-        outln!("wrote {}", written.join(", "));
-    }
+    super::stdout::wrote([&a.csv, &a.png].into_iter().flatten());
     Ok(())
 }

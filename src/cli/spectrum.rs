@@ -244,16 +244,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         line_plot_png(&plot, path)?;
     }
-    let written: Vec<String> = [&a.csv, &a.npy, &a.radial, &a.png, &a.radial_png]
+    let written: Vec<_> = [&a.csv, &a.npy, &a.radial, &a.png, &a.radial_png]
         .into_iter()
         .flatten()
-        .map(|p| p.display().to_string())
         .collect();
     if written.is_empty() {
         let mut out = std::io::stdout().lock();
         radial_csv(&mut out)?;
-    } else {
-        outln!("wrote {}", written.join(", "));
     }
+    super::stdout::wrote(written);
     Ok(())
 }

@@ -93,6 +93,18 @@ macro_rules! outln {
     };
 }
 
+/// "wrote A, B": the files a command wrote, in one line (nothing when
+/// there are none).
+pub fn wrote<P: AsRef<std::path::Path>>(paths: impl IntoIterator<Item = P>) {
+    let names: Vec<String> = paths
+        .into_iter()
+        .map(|p| p.as_ref().display().to_string())
+        .collect();
+    if !names.is_empty() {
+        line(format_args!("wrote {}", names.join(", ")));
+    }
+}
+
 /// `n` and the noun, plural unless n = 1: "1 set", "16 sets".
 pub fn counted(n: usize, noun: &str) -> String {
     if n == 1 {
