@@ -381,5 +381,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
              results/rates)."
         );
     }
+    super::stdout::wrote([&a.csv, &a.png].into_iter().flatten());
     Ok(())
 }

@@ -15,8 +15,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     for i in INTEGRANDS {
         if a.list {
             out += &format!("{} ({}D)\n    {}\n", i.name, i.dim, i.summary);
+            // One column for the meanings, whatever the keys' lengths.
+            let width = i
+                .params
+                .iter()
+                .map(|(key, default, _)| key.chars().count() + 1 + default.chars().count())
+                .max()
+                .unwrap_or(0);
             for (key, default, help) in i.params {
-                out += &format!("    {key}={default:<6} {help}\n");
+                let assignment = format!("{key}={default}");
+                out += &format!("    {assignment:<width$}  {help}\n");
             }
         } else {
             out += &format!("{:<10} {}D  {}\n", i.name, i.dim, i.summary);
