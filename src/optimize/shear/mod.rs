@@ -34,6 +34,11 @@ use crate::points::{PointSet, wrap01};
 use crate::rng::SetRng;
 use crate::samplers::{Sampler, SamplerError};
 
+/// The relative change of J the search resolves: the polish stops when its
+/// simplex's J agree to this, and a shear must lower J by more than this
+/// to be kept over no shear.
+const J_RESOLUTION: f64 = 1e-8;
+
 /// Shear offset at which `sensitivity` reports J.
 pub const SENSITIVITY_STEP: f64 = 0.01;
 /// Step of the scan over the whole range.
@@ -57,8 +62,9 @@ pub struct ShearResult {
     pub initial: ([f64; 2], f64),
     /// J at (a ∓ 0.01, b) and (a, b ∓ 0.01): how sharp the optimum is.
     pub sensitivity: [f64; 4],
-    /// Whether the search fell back to no shear (what it found had J
-    /// above the unsheared one).
+    /// Whether the result is no shear: what the search found was (0, 0)
+    /// itself or had J above the unsheared one (off the spectrum's line:
+    /// not below it by more than the search resolves, 1e-8 of J).
     pub kept_unsheared: bool,
     /// Objective evaluations.
     pub evaluations: u64,
@@ -222,10 +228,10 @@ pub fn search_shear(
         vec![shear[0], shear[1] + step],
     ];
     let solver = NelderMead::new(simplex)
-        // J to 1e-8 of itself (|J|: an estimated J may come out ≤ 0,
-        // and argmin refuses a negative tolerance): far below its
+        // J to J_RESOLUTION of itself (|J|: an estimated J may come out
+        // ≤ 0, and argmin refuses a negative tolerance): far below its
         // truncation bound and stderr.
-        .with_sd_tolerance(1e-8 * lined.abs())
+        .with_sd_tolerance(J_RESOLUTION * lined.abs())
         .map_err(|e| OptimizeError::Search(e.to_string()))?;
     let result = Executor::new(Joint(objective), solver)
         .configure(|s| s.max_iters(100))
@@ -253,7 +259,18 @@ pub fn search_shear(
             optimum = at_line;
         }
     }
-    let kept_unsheared = optimum.value > unsheared.value;
+    // Off the spectrum's line, a gain below the polish's resolution is no
+    // gain: no shear is kept exactly (a symmetric double wedge's optimum is
+    // (0, 0), which the polish otherwise returned as a shear of 1e-9). On
+    // the line, a tie keeps the line, which the spectrum chose where J
+    // cannot tell shears apart (a hairline aperture).
+    let on_line = !start.double_wedge && shear == line;
+    let resolution = if on_line {
+        0.0
+    } else {
+        J_RESOLUTION * unsheared.value.abs()
+    };
+    let kept_unsheared = optimum.value > unsheared.value - resolution || shear == [0.0, 0.0];
     if kept_unsheared {
         shear = [0.0, 0.0];
         optimum = unsheared;
