@@ -488,7 +488,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     outln!("speed against error, {threads} threads; errors are max over k against the direct sums");
     outln!(
-        "{:<44} {:<16} {:>11} {:>14} {:>14}",
+        "{:<44} {:<32} {:>11} {:>14} {:>14}",
         "case",
         "method",
         "seconds",
@@ -504,7 +504,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
     let (direct_s, exact) = time(2, || sample_spectrum(&points, &freqs));
     let push = |rows: &mut Vec<Row>, r: Row| {
         outln!(
-            "{:<44} {:<16} {:>11.5} {:>14} {:>14}",
+            "{:<44} {:<32} {:>11.5} {:>14} {:>14}",
             r.case,
             r.method,
             r.seconds,
