@@ -1,4 +1,4 @@
-//! `varspec compare`: the default job. Generates every 2D sampler at one N,
+//! `varspec compare`: a first look. Generates every 2D sampler at one N,
 //! prints a side-by-side table and writes a picture of each pattern.
 
 use std::path::PathBuf;

@@ -66,8 +66,9 @@ enum Command {
     Spectrum(spectrum::Args),
     /// Pair correlation function g(r) of point sets (Gaussian kernel estimator).
     Pcf(pcf::Args),
-    /// Variance of the shift-randomized estimator: Fourier, spatial and
-    /// empirical predictors side by side.
+    /// Variance of a point set's estimate of an integral (shift-randomized
+    /// on the torus by default, or as drawn; on the unit square; a scene
+    /// pixel): Fourier, spatial and empirical predictors side by side.
     Predict(predict::Args),
     /// Variance against N, the fitted log-log slope with its CI, and theory.
     Converge(converge::Args),
@@ -77,7 +78,8 @@ enum Command {
     /// Merge an experiment's shard files into exactly the tables a single
     /// run writes.
     Merge(experiment::MergeArgs),
-    /// Optimizers: point positions toward a target spectrum.
+    /// Optimizers: point positions toward a target (blue noise, an
+    /// integrand, 4D spectra per projection) and the shear of 4D sets.
     #[command(subcommand)]
     Optimize(optimize::OptimizeCommand),
     /// Render a scene whose pixels are 4D integrands (depth of field, soft
@@ -95,8 +97,8 @@ enum Command {
     /// Benchmarks that print speed against error.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
-    /// Generate every 2D sampler at one N and compare them side by side
-    /// (the default job: try `varspec compare`).
+    /// Generate every 2D sampler at one N and compare them side by side:
+    /// speed, spacing, pictures.
     Compare(compare::Args),
 }
 
