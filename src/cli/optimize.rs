@@ -421,25 +421,13 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
         );
     }
     let baselines: Vec<(&str, f64)> = design.baselines.iter().map(|b| (b.name, b.score)).collect();
-    loss_curve_outputs(
+    design_outputs(
         &a,
         &format!("{} N={}", a.target, a.n),
-        &design.loss_curve_seconds,
-        &design.loss_curve,
+        (&design.loss_curve_seconds, &design.loss_curve),
         &baselines,
-    )?;
-    if let Some(path) = &a.report {
-        write_atomic(path, |w| {
-            w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
-        })?;
-    }
-    super::stdout::wrote(
-        std::iter::once(&a.output)
-            .chain(&a.curve)
-            .chain(&a.curve_png)
-            .chain(&a.report),
-    );
-    Ok(())
+        &design,
+    )
 }
 
 /// `optimize points -d 4` with targets per projection: one 4D descent on
@@ -482,25 +470,13 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
         closest.xy,
         closest.uv
     );
-    loss_curve_outputs(
+    design_outputs(
         &a,
         &format!("{} N={} in 4D", a.target, a.n),
-        &design.loss_curve_seconds,
-        &design.loss_curve,
+        (&design.loss_curve_seconds, &design.loss_curve),
         &[],
-    )?;
-    if let Some(path) = &a.report {
-        write_atomic(path, |w| {
-            w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
-        })?;
-    }
-    super::stdout::wrote(
-        std::iter::once(&a.output)
-            .chain(&a.curve)
-            .chain(&a.curve_png)
-            .chain(&a.report),
-    );
-    Ok(())
+        &design,
+    )
 }
 
 /// The family members a square design is scored on without --members.
@@ -567,25 +543,13 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
                 .unwrap_or(f64::NAN)
         );
     }
-    loss_curve_outputs(
+    design_outputs(
         &a,
         &format!("{} N={} on the square", a.target, a.n),
-        &design.loss_curve_seconds,
-        &design.loss_curve,
+        (&design.loss_curve_seconds, &design.loss_curve),
         &[],
-    )?;
-    if let Some(path) = &a.report {
-        write_atomic(path, |w| {
-            w.write_all(serde_json::to_string_pretty(&design)?.as_bytes())
-        })?;
-    }
-    super::stdout::wrote(
-        std::iter::once(&a.output)
-            .chain(&a.curve)
-            .chain(&a.curve_png)
-            .chain(&a.report),
-    );
-    Ok(())
+        &design,
+    )
 }
 
 /// The XU and YV planes of a 4D set: name, coordinates, frequency axes.
@@ -905,15 +869,17 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The files every `optimize points` design writes beside its points:
 /// `--curve` (CSV) and `--curve-png` (log-log against time, with the
 /// classic samplers' losses as flat references where the design has them)
-/// of set 0's loss curve.
-fn loss_curve_outputs(
+/// of set 0's loss curve (`seconds`, `loss`), and `--report` (the design as
+/// JSON); then says which files were written.
+fn design_outputs(
     a: &PointsArgs,
     what: &str,
-    seconds: &[f64],
-    loss: &[f64],
+    (seconds, loss): (&[f64], &[f64]),
     baselines: &[(&str, f64)],
+    design: &impl serde::Serialize,
 ) -> anyhow::Result<()> {
     use varspec::report::plot::{LinePlot, Series, line_plot_png};
     let curve: Vec<(f64, f64)> = seconds.iter().copied().zip(loss.iter().copied()).collect();
@@ -949,6 +915,17 @@ fn loss_curve_outputs(
         };
         line_plot_png(&plot, path)?;
     }
+    if let Some(path) = &a.report {
+        write_atomic(path, |w| {
+            w.write_all(serde_json::to_string_pretty(design)?.as_bytes())
+        })?;
+    }
+    super::stdout::wrote(
+        std::iter::once(&a.output)
+            .chain(&a.curve)
+            .chain(&a.curve_png)
+            .chain(&a.report),
+    );
     Ok(())
 }
 

@@ -30,7 +30,7 @@ pub const REFERENCE_POINTS: usize = 1 << 16;
 /// single stratified set cannot give. 2^20 rays in all, about 0.1 s.
 pub const REFERENCE_SETS: usize = 16;
 
-/// Seed of the reference set.
+/// Seed of the reference sets (one stream per pixel and set).
 const REFERENCE_SEED: u64 = 0x5049_5845_4c52_4546;
 
 /// Pixel (px, py) of a scene as an integrand on [0, 1)^4.
