@@ -405,4 +405,139 @@ mod tests {
             "{below}"
         );
     }
+
+    /// Unit normal and area of a triangle.
+    fn normal_area([a, b, c]: [[f64; 3]; 3]) -> ([f64; 3], f64) {
+        let n = description::cross(description::sub(b, a), description::sub(c, a));
+        let len = description::norm(n);
+        (n.map(|x| x / len), len / 2.0)
+    }
+
+    /// Every undirected edge in exactly two triangles: a closed surface.
+    fn closed(triangles: &[[[f64; 3]; 3]]) -> bool {
+        let key = |p: [f64; 3]| p.map(|x| (x * 1e9).round() as i64);
+        let mut edges = std::collections::HashMap::new();
+        for t in triangles {
+            for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+                let (p, q) = (key(t[i]), key(t[j]));
+                *edges
+                    .entry(if p < q { (p, q) } else { (q, p) })
+                    .or_insert(0) += 1;
+            }
+        }
+        edges.values().all(|&n| n == 2)
+    }
+
+    #[test]
+    fn built_in_box_and_sphere_are_closed_surfaces_of_their_size() {
+        use description::ShapeKind;
+        use geometry::shape_triangles;
+        let cube = shape_triangles(ShapeKind::Box, 0).unwrap();
+        let area: f64 = cube.iter().map(|&t| normal_area(t).1).sum();
+        // The cube [−1, 1]³: six faces of area 4.
+        assert_eq!((cube.len(), area), (12, 24.0));
+        assert!(closed(&cube));
+        for levels in 0..=4 {
+            let sphere = shape_triangles(ShapeKind::Sphere, levels).unwrap();
+            assert_eq!(sphere.len(), 20 << (2 * levels));
+            assert!(closed(&sphere), "level {levels}");
+            assert!(
+                sphere
+                    .iter()
+                    .flatten()
+                    .all(|p| (description::norm(*p) - 1.0).abs() < 1e-15),
+                "vertices on the unit sphere"
+            );
+            // A convex polyhedron between the balls of radius ρ (its
+            // faces' least distance from the centre) and 1 has a surface
+            // area between theirs.
+            let rho = sphere
+                .iter()
+                .map(|&t| dot(normal_area(t).0, t[0]).abs())
+                .fold(1.0, f64::min);
+            let area: f64 = sphere.iter().map(|&t| normal_area(t).1).sum();
+            let ball = 4.0 * std::f64::consts::PI;
+            assert!(
+                ball * rho * rho <= area && area <= ball,
+                "level {levels}: area {area}, ρ {rho}"
+            );
+            if levels == 4 {
+                assert!(rho > 0.99, "ρ {rho}");
+            }
+        }
+    }
+
+    /// Rays toward a placed (scaled, rotated, translated) box and sphere
+    /// hit where the closed forms say: the box at 6 − min_i h_i/|d_i| (d in
+    /// the box's frame, h its half sides), with the face's normal; the
+    /// sphere of radius r between 6 − r and 6 − r·ρ (ρ its tessellation's
+    /// inner radius).
+    #[test]
+    fn rays_hit_placed_boxes_and_spheres_where_the_closed_forms_say() {
+        use crate::rng::{set_rng, uniform};
+        let centre = [1.0, 2.0, -3.0];
+        let (half, angle, r) = ([0.5, 1.0, 2.0], 30f64.to_radians(), 0.7);
+        let scene = |object: &str| {
+            Scene::from_text(
+                &format!(
+                    r#"{{"camera": {{"resolution": [1, 1], "fov_degrees": 30, "position": [0, 0, 0],
+                                   "look_at": [0, 0, -1], "focal_distance": 1, "aperture": 0}},
+                        "integrand": "lens", "ambient": 1,
+                        "objects": [{{{object}, "translate": [1, 2, -3],
+                                     "material": {{"texture": "constant", "albedo": 0.5}}}}]}}"#
+                ),
+                "t",
+            )
+            .unwrap()
+        };
+        let cuboid = scene(r#""shape": "box", "scale": [0.5, 1, 2], "rotate_y_degrees": 30"#);
+        let ball = scene(r#""shape": "sphere", "subdivisions": 4, "scale": [0.7, 0.7, 0.7]"#);
+        let rho = geometry::shape_triangles(description::ShapeKind::Sphere, 4)
+            .unwrap()
+            .iter()
+            .map(|&t| dot(normal_area(t).0, t[0]).abs())
+            .fold(1.0, f64::min);
+        // World to the box's frame: the inverse rotation about y.
+        let to_frame = |d: [f64; 3]| {
+            [
+                angle.cos() * d[0] - angle.sin() * d[2],
+                d[1],
+                angle.sin() * d[0] + angle.cos() * d[2],
+            ]
+        };
+        let mut rng = set_rng(5, 0);
+        for _ in 0..200 {
+            // A uniform direction.
+            let z = 2.0 * uniform(&mut rng) - 1.0;
+            let phi = 2.0 * std::f64::consts::PI * uniform(&mut rng);
+            let s = (1.0 - z * z).sqrt();
+            let d = [s * phi.cos(), s * phi.sin(), z];
+            let origin: [f64; 3] = std::array::from_fn(|k| centre[k] - 6.0 * d[k]);
+            let local = to_frame(d);
+            let (axis, reach) = (0..3)
+                .map(|i| (i, half[i] / local[i].abs()))
+                .fold((0, f64::INFINITY), |m, c| if c.1 < m.1 { c } else { m });
+            let hit = cuboid.geometry().closest(origin, d, 0.0).expect("the box");
+            assert!(
+                (hit.t - (6.0 - reach)).abs() < 1e-5,
+                "box: t {} vs {}",
+                hit.t,
+                6.0 - reach
+            );
+            let n = to_frame(hit.normal);
+            assert!(
+                (n[axis].abs() - 1.0).abs() < 1e-5 && dot(hit.normal, d) < 0.0,
+                "box normal {:?} (frame {n:?}), face axis {axis}",
+                hit.normal
+            );
+            let hit = ball.geometry().closest(origin, d, 0.0).expect("the sphere");
+            assert!(
+                hit.t >= 6.0 - r - 1e-5 && hit.t <= 6.0 - r * rho + 1e-5,
+                "sphere: t {} outside [{}, {}]",
+                hit.t,
+                6.0 - r,
+                6.0 - r * rho
+            );
+        }
+    }
 }
