@@ -510,3 +510,41 @@ fn predict_on_a_pixel_gives_the_variance_its_render_measures() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A pixel's reference (16 sets drawn in parallel) and its empirical
+/// variance are the same numbers on one thread and two: the JSON of
+/// `predict` is identical but for its wall times.
+#[test]
+fn predict_on_a_pixel_is_identical_on_one_and_two_threads() {
+    let run = |threads: &str| {
+        let out = varspec_with(
+            &[
+                "predict",
+                "--integrand",
+                "scene:dof,px=112,py=95",
+                "--sampler",
+                "umj",
+                "-n",
+                "16",
+                "--realizations",
+                "200",
+                "--json",
+            ],
+            Some(threads),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mut report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        report["empirical"]
+            .as_object_mut()
+            .unwrap()
+            .remove("seconds");
+        report
+    };
+    let one = run("1");
+    assert!(one["integral_stderr"].as_f64().unwrap() > 0.0, "{one}");
+    assert_eq!(one, run("2"));
+}
