@@ -668,8 +668,7 @@ fn a_pixel_as_an_integrand_has_its_closed_form_integral_and_variance() {
 /// z = (I ≈ − I)/se are independent Student t with 15 degrees of freedom,
 /// so the mean of the 40 z² lies in [0.45, 2.50] with probability 99.9%
 /// (its 0.05% and 99.95% quantiles, from 4·10^5 simulated means). An error
-/// bar half the true one puts that mean above 2.4, twice it below 0.5, in
-/// 99% of cases.
+/// bar half the true one fails this in 98.6% of cases, twice it in 97.5%.
 #[test]
 fn a_pixel_integral_s_standard_error_covers_the_closed_form() {
     use std::sync::Arc;
