@@ -579,13 +579,9 @@ fn the_written_sets_are_the_seeded_sets_sheared_by_the_found_shear() {
     let (sheared, drawn) = (dir.join("sheared.csv"), dir.join("drawn.csv"));
     let prefix = dir.join("p");
     let spec = "defocus:shape=disk,size=0.3,c=0.5";
-    let common = [
-        "-n",
-        "64",
-        "--sets",
-        "3",
-        "--seed",
-        "11",
+    // The sets both commands draw.
+    let draw = ["-n", "64", "--sets", "3", "--seed", "11"];
+    let outputs = [
         "--integrand",
         spec,
         "-o",
@@ -593,6 +589,7 @@ fn the_written_sets_are_the_seeded_sets_sheared_by_the_found_shear() {
         "--png-prefix",
         prefix.to_str().unwrap(),
     ];
+    let common = [&draw[..], &outputs].concat();
     let json = crate::common::varspec_ok(&[&["optimize", "shear", "--json"][..], &common].concat());
     let report: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
     let [a, b] = [0, 1].map(|i| report["shear"][i].as_f64().unwrap());
@@ -600,18 +597,14 @@ fn the_written_sets_are_the_seeded_sets_sheared_by_the_found_shear() {
         a < -0.3 && b < -0.3,
         "the shear of c = 0.5 is near −0.5: {a}, {b}"
     );
-    crate::common::varspec_ok(&[
-        "sample",
-        "umj",
-        "-n",
-        "64",
-        "--sets",
-        "3",
-        "--seed",
-        "11",
-        "-o",
-        drawn.to_str().unwrap(),
-    ]);
+    crate::common::varspec_ok(
+        &[
+            &["sample", "umj"][..],
+            &draw,
+            &["-o", drawn.to_str().unwrap()],
+        ]
+        .concat(),
+    );
     let (after, before) = (
         varspec::io::read_point_sets(&sheared).unwrap(),
         varspec::io::read_point_sets(&drawn).unwrap(),
