@@ -94,9 +94,11 @@ pub struct PointsArgs {
     /// autocovariance; cmj for other 2D integrand targets; random for other
     /// torus targets; umj for projection targets; on the square jitter, or
     /// cmj where N is not m²).
-    /// `--sampler` as in every other command.
-    #[arg(long, visible_alias = "sampler")]
+    #[arg(long, value_name = "SAMPLER")]
     init: Option<String>,
+    /// The same as --init (the sampler, as in every other command).
+    #[arg(long = "sampler", value_name = "SAMPLER", conflicts_with = "init")]
+    sampler_flag: Option<String>,
     /// Square: family members the result and the classic samplers are scored
     /// on (at least 2, for the standard error) [default: 1024].
     #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
@@ -180,7 +182,8 @@ enum DomainArg {
     Square,
 }
 
-fn points(a: PointsArgs) -> anyhow::Result<()> {
+fn points(mut a: PointsArgs) -> anyhow::Result<()> {
+    a.init = a.init.take().or(a.sampler_flag.take());
     args::check_outputs_beside(
         [
             Some(a.output.as_path()),
