@@ -676,3 +676,44 @@ fn converge_notes_a_theory_outside_the_interval_and_refuses_rounding_noise() {
     common::assert_fails(&args, "N = 256: the variance");
     common::assert_fails(&args, "at or below the fourier form's rounding bound");
 }
+
+/// Without a shift a file's sets are its realizations, each once: by
+/// default predict takes them all (it used to ask for 10,000 and refuse its
+/// own default), and more than the file holds is refused.
+#[test]
+fn unshifted_predict_on_a_file_takes_each_set_once() {
+    let dir = common::temp_dir("predict-unshifted");
+    let sets = dir.join("j8.csv");
+    common::varspec_ok(&[
+        "sample",
+        "jitter",
+        "-n",
+        "64",
+        "--sets",
+        "8",
+        "-o",
+        sets.to_str().unwrap(),
+    ]);
+    let base = [
+        "predict",
+        sets.to_str().unwrap(),
+        "--integrand",
+        "disk:r=0.3",
+        "--method",
+        "empirical",
+        "--shift",
+        "none",
+    ];
+    let v = json(&[&base[..], &["--json"]].concat());
+    assert_eq!(v["empirical"]["realizations"], 8, "{v}");
+    common::assert_fails(
+        &[&base[..], &["--realizations", "9"]].concat(),
+        "the file's 8 set(s) give only 8 distinct estimates",
+    );
+    // `-` is not taken for standard output, nor written as a file of that name.
+    common::assert_fails(
+        &["sample", "jitter", "-n", "16", "-o", "-"],
+        "give /dev/stdout for standard output",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -239,9 +239,10 @@ where
     }
 }
 
-/// Checks, before any work, that `path` can be written: its folder exists,
-/// it is not a folder itself, and a file can be created there (or the
-/// device opened).
+/// Checks, before any work, that `path` can be written: it is not `-`
+/// (which other tools read as standard output), its folder exists, it is
+/// not a folder itself, and a file can be created there (or the device
+/// opened).
 ///
 /// # Errors
 /// [`WriteError`] naming `path` and what is wrong.
@@ -250,6 +251,13 @@ pub fn check_output(path: &Path) -> Result<(), WriteError> {
         path: path.to_path_buf(),
         cause: io::Error::other(message),
     };
+    // Many tools read `-` as standard output; here it would be a file
+    // named `-`.
+    if path.as_os_str() == "-" {
+        return Err(fail(
+            "`-` would be a file of that name: give /dev/stdout for standard output".into(),
+        ));
+    }
     let target = resolve_links(path).map_err(|cause| WriteError {
         path: path.to_path_buf(),
         cause,
