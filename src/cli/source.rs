@@ -130,6 +130,9 @@ impl SourceArgs {
                     }
                     built => built?,
                 };
+                if let Some(caveat) = sampler.caveat() {
+                    eprintln!("note: {caveat}");
+                }
                 Source::Sampler {
                     sampler,
                     seed: self.draw.seed(),

@@ -88,6 +88,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (Some(name), _) => {
             let n = a.n.context("--sampler needs -n")?;
             let s = registry::build(name, n, a.dim, &a.draw.params)?;
+            if let Some(caveat) = s.caveat() {
+                eprintln!("note: {caveat}");
+            }
             let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =
                 samplers::generate_sets(s.as_ref(), a.draw.seed(), a.draw.sets(), &|| bar.inc(1))?;

@@ -64,6 +64,16 @@ pub trait Sampler: Send + Sync {
     fn halves(&self) -> Option<[&dyn Sampler; 2]> {
         None
     }
+    /// What a user should know about this instance that its name does not
+    /// say (a multi-jittered set of N with no divisor near √N is a thin
+    /// grid that stratifies like N-rooks); `None` when nothing. A padded
+    /// sampler says its halves'.
+    fn caveat(&self) -> Option<String> {
+        let halves = self.halves()?;
+        let mut said: Vec<String> = halves.iter().filter_map(|h| h.caveat()).collect();
+        said.dedup();
+        (!said.is_empty()).then(|| said.join("; "))
+    }
 }
 
 /// What is wrong with a sampler request.

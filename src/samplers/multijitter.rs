@@ -125,6 +125,28 @@ impl Sampler for MultiJitter {
     fn pair_spectrum(&self) -> Option<&dyn PairSpectrum> {
         Some(self)
     }
+
+    /// A grid more than 4 times longer than wide (m < √N/2): its strata
+    /// are thin strips, so on a 2D integrand it converges like N-rooks
+    /// (N^-1 on a disk), not like the grid's N^-1.5.
+    fn caveat(&self) -> Option<String> {
+        let (m, rows) = (self.columns.min(self.rows), self.columns.max(self.rows));
+        (4 * m < rows).then(|| {
+            let n = self.points_per_set();
+            let square = (n as f64).sqrt().round() as usize;
+            format!(
+                "{} N = {n} is a {m} x {rows} grid (N has no divisor near √N): its strata are \
+                 strips, it converges like N-rooks rather than a 2D grid; N = {} (or any m·n \
+                 with m near √N) restores the grid",
+                if self.correlated {
+                    "cmj"
+                } else {
+                    "multijitter"
+                },
+                square * square
+            )
+        })
+    }
 }
 
 /// C(ω, ω′) in closed form. The x coordinates depend only on the σ shuffles
