@@ -450,3 +450,49 @@ fn a_sharded_table_run_merges_to_the_single_runs_bytes() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("shard 1/3 is missing"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Without --format the output's name says it (.csv, .json, .h): the table
+/// is byte for byte the one --format writes; a name that says none (raw
+/// floats have no conventional extension) is refused naming the choices.
+#[test]
+fn the_format_follows_the_output_name() {
+    let d = dir().join("named");
+    std::fs::create_dir_all(&d).unwrap();
+    for (ext, format) in [("csv", "csv"), ("json", "json"), ("h", "c-header")] {
+        let (named, given) = (
+            d.join(format!("named.{ext}")),
+            d.join(format!("given.{ext}")),
+        );
+        let draw = ["tables", "--sampler", "cmj", "-n", "16", "--sets", "2"];
+        varspec(&[&draw[..], &["-o", named.to_str().unwrap()]].concat());
+        varspec(
+            &[
+                &draw[..],
+                &["--format", format, "-o", given.to_str().unwrap()],
+            ]
+            .concat(),
+        );
+        let (a, b) = (
+            std::fs::read(&named).unwrap(),
+            std::fs::read(&given).unwrap(),
+        );
+        // The C header may name its file (an include guard): compare the rest.
+        let strip = |bytes: &[u8], name: &str| {
+            String::from_utf8_lossy(bytes)
+                .replace(name, "")
+                .replace(&name.to_uppercase(), "")
+        };
+        assert_eq!(strip(&a, "named"), strip(&b, "given"), "{ext}");
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args(["tables", "--sampler", "cmj", "-n", "16", "-o"])
+        .arg(d.join("t.bin"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("does not name one (.csv, .json, .h)"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
+}

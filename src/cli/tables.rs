@@ -45,8 +45,9 @@ pub struct Args {
     dim: Option<usize>,
     #[command(flatten)]
     draw: DrawArgs,
-    /// Output format.
-    #[arg(long, value_enum, required_unless_present = "shard")]
+    /// Output format [default: from the output's name: .csv, .json, .h or
+    /// .hpp; f32 and f64 are named with --format].
+    #[arg(long, value_enum)]
     format: Option<FormatArg>,
     /// Output file (csv, f32 and f64 also get PATH.json with the metadata).
     #[arg(short = 'o', long = "output")]
@@ -109,7 +110,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         (None, None) => bail!("give --sampler or --from"),
     };
-    let format = match a.format.context("--format is needed to write a table")? {
+    let named = match a
+        .output
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .as_deref()
+    {
+        Some("csv") => Some(FormatArg::Csv),
+        Some("json") => Some(FormatArg::Json),
+        Some("h" | "hpp") => Some(FormatArg::CHeader),
+        _ => None,
+    };
+    let format = a.format.or(named).with_context(|| {
+        format!(
+            "--format is needed: {} does not name one (.csv, .json, .h); f32 and f64 are \
+             raw floats, named with --format",
+            a.output.display()
+        )
+    })?;
+    let format = match format {
         FormatArg::Csv => TableFormat::Csv,
         FormatArg::Json => TableFormat::Json,
         FormatArg::F32 => TableFormat::F32,
