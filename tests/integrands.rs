@@ -241,6 +241,10 @@ fn bad_specs_are_clear_errors() {
     ));
     assert!(matches!(err("disk:r"), IntegrandError::Syntax { .. }));
     for (spec, phrase) in [
+        (
+            "disk:r=abc",
+            "r=abc is invalid: expected a number (a radius in (0, 0.5])",
+        ),
         ("disk:r=0.6", "(0, 0.5]"),
         ("disk:r=-0.1", "(0, 0.5]"),
         ("disk:r=NaN", "(0, 0.5]"),

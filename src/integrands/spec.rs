@@ -145,16 +145,18 @@ impl Params {
         }
     }
 
-    /// A finite number satisfying `ok`, else an error quoting `expected`.
+    /// A finite number satisfying `ok`, else an error quoting `expected`
+    /// (and saying so when the text is not a number at all).
     fn number(
         &self,
         key: &'static str,
         ok: impl Fn(f64) -> bool,
         expected: &str,
     ) -> Result<f64, IntegrandError> {
-        self.text(key)
-            .parse::<f64>()
-            .ok()
+        let Ok(v) = self.text(key).parse::<f64>() else {
+            return Err(self.bad(key, &format!("a number ({expected})")));
+        };
+        Some(v)
             .filter(|v| v.is_finite() && ok(*v))
             .ok_or_else(|| self.bad(key, expected))
     }
