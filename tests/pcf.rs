@@ -114,3 +114,36 @@ fn a_random_count_process_takes_its_radii_from_its_density() {
         );
     }
 }
+
+/// With few points in 4D the default range (2.5 packing distances) would
+/// reach half the torus: it shrinks to 99% of the largest that does not
+/// (0.782 r_max for N = 256, σ = 0.15), with a note; a range given is kept
+/// or refused, never changed.
+#[test]
+fn the_default_range_fits_the_torus_and_a_given_one_is_kept() {
+    let dir = crate::common::temp_dir("pcf-range");
+    let csv = dir.join("g.csv");
+    let base = ["pcf", "--sampler", "umj", "-n", "256", "--sets", "4"];
+    let out = crate::common::varspec_ok(&[&base[..], &["--csv", csv.to_str().unwrap()]].concat());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("note: --range 0.774 r_max (not 2.5)"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let last = std::fs::read_to_string(&csv).unwrap();
+    let r_rel: f64 = last
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(1)
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((r_rel - 0.99 * 0.782).abs() < 2e-3, "{r_rel}");
+    crate::common::assert_fails(
+        &[&base[..], &["--range", "2.5"]].concat(),
+        "lower --range to below 0.782",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -15,9 +15,11 @@ use varspec::spectrum::pcf::pair_correlation;
 pub struct Args {
     #[command(flatten)]
     source: SourceArgs,
-    /// Largest radius, in units of the densest-packing distance r_max.
-    #[arg(long, default_value_t = 2.5)]
-    range: f64,
+    /// Largest radius, in units of the densest-packing distance r_max
+    /// [default: 2.5, or less where that would reach half the torus (few
+    /// points in 3D or 4D)].
+    #[arg(long)]
+    range: Option<f64>,
     /// Radii evaluated in (0, range].
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 100)]
     bins: usize,
@@ -32,24 +34,29 @@ pub struct Args {
     png: Option<PathBuf>,
 }
 
+/// `--range` when not given, where it fits the torus.
+const DEFAULT_RANGE: f64 = 2.5;
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs_beside([a.csv.as_deref(), a.png.as_deref()], [a.source.file()])?;
-    if !(a.range.is_finite() && a.range >= 1e-3) {
+    let given = a.range;
+    if let Some(range) = given
+        && !(range.is_finite() && range >= 1e-3)
+    {
         bail!(
-            "--range {:?}: the largest radius, in units of the packing distance r_max, must be a \
-             number of at least 0.001, the smallest --bandwidth (default 2.5)",
-            a.range
+            "--range {range:?}: the largest radius, in units of the packing distance r_max, must \
+             be a number of at least 0.001, the smallest --bandwidth (default 2.5)"
         );
     }
+    let mut range = given.unwrap_or(DEFAULT_RANGE);
     if a.bins == 0 {
         bail!("--bins 0: the number of radii must be at least 1 (default 100)");
     }
-    if !(a.bandwidth.is_finite() && a.bandwidth >= 1e-3 && a.bandwidth <= a.range) {
+    if !(a.bandwidth.is_finite() && a.bandwidth >= 1e-3 && a.bandwidth <= range) {
         bail!(
             "--bandwidth {:?}: the kernel's σ, in units of the packing distance r_max, must be in \
-             [0.001, --range = {:?}] (default 0.15; below 0.001 no pair falls within a kernel width)",
+             [0.001, --range = {range:?}] (default 0.15; below 0.001 no pair falls within a kernel width)",
             a.bandwidth,
-            a.range
         );
     }
     let source = a.source.resolve(None)?;
@@ -68,13 +75,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     // The estimator needs (range + 6σ)·r_max < 1/2 (beyond, toroidal
     // distances alias): say so in the units the options are given in.
-    let reach = a.range + 6.0 * a.bandwidth;
+    // The default shrinks to fit (to 99% of the largest range that does),
+    // saying so; a range given is kept or refused.
+    let largest = 0.5 / unit - 6.0 * a.bandwidth;
+    if given.is_none() && range >= largest && 0.99 * largest >= a.bandwidth {
+        range = 0.99 * largest;
+        eprintln!(
+            "note: --range {range:.3} r_max (not {DEFAULT_RANGE}): with N = {n} in {d}D the pair \
+             correlation aliases beyond {:.3} r_max, half the torus, less 6 kernel widths",
+            0.5 / unit
+        );
+    }
+    let reach = range + 6.0 * a.bandwidth;
     if reach * unit >= 0.5 {
-        let largest = 0.5 / unit - 6.0 * a.bandwidth;
         bail!(
             "--range {:?} + 6 x --bandwidth {:?} = {reach:.3} packing distances reaches half the torus \
              (r_max = {unit:.4} for N = {n}: the pair correlation aliases beyond {:.3} r_max); {}",
-            a.range,
+            range,
             a.bandwidth,
             0.5 / unit,
             if largest > a.bandwidth {
@@ -84,7 +101,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }
         );
     }
-    let pcf = pair_correlation(&sets, a.range * unit, a.bins, a.bandwidth * unit)?;
+    let pcf = pair_correlation(&sets, range * unit, a.bins, a.bandwidth * unit)?;
     #[derive(serde::Serialize)]
     struct Row {
         r: f64,
@@ -129,7 +146,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 },
                 Series {
                     label: "white noise".into(),
-                    points: vec![(0.0, 1.0), (a.range, 1.0)],
+                    points: vec![(0.0, 1.0), (range, 1.0)],
                     reference: true,
                 },
             ],
