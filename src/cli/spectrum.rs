@@ -125,10 +125,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Some(dims) => dims.map(|d| AXES.get(d).copied().unwrap_or("k")),
         None => ["kx", "ky"],
     };
+    // A projection's title names its plane (XU for dims 0,2).
+    let plane_name = plane.map_or(String::new(), |_| {
+        let name: String = axes
+            .iter()
+            .map(|a| a.trim_start_matches('k').to_uppercase())
+            .collect();
+        format!(", {name} plane")
+    });
     let (spectrum, title, bar_label) = match &a.integrand {
         Some(spec) => {
             let (power, name) = integrand_power(spec, plane, freqs.half, a.source.seed())?;
-            (power, format!("{name}, P_f"), "log10 |F_f(k)|^2")
+            (
+                power,
+                format!("{name}{plane_name}, P_f"),
+                "log10 |F_f(k)|^2",
+            )
         }
         None => {
             if !a.source.given() {
@@ -158,7 +170,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             )?;
             bar.finish_and_clear();
             let title = format!(
-                "{} ({})",
+                "{}{plane_name} ({})",
                 source.name(),
                 super::stdout::counted(spectrum.sets, "set")
             );
