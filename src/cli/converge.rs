@@ -314,7 +314,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         })?;
     }
     if let Some(path) = &a.png {
-        let (n0, v0) = (ns[0], vars[0]);
+        // Reference slopes start a factor 3 below the first level, so the
+        // one the data follows runs beside it rather than under it.
+        let (n0, v0) = (ns[0], vars[0] / 3.0);
         let line = |slope: f64| {
             vec![
                 (n0, v0),

@@ -168,6 +168,11 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
                         .draw_series(DashedLineSeries::new(data, 6, 4, style))
                         .map_err(draw_error)?
                 } else {
+                    // Markers on the data, so measured points stand out from
+                    // a reference line running through them.
+                    chart
+                        .draw_series(data.iter().map(|&p| Circle::new(p, 4, colour.filled())))
+                        .map_err(draw_error)?;
                     chart
                         .draw_series(LineSeries::new(data, style))
                         .map_err(draw_error)?
