@@ -775,54 +775,23 @@ fn one_grammar_across_commands() {
         "-o",
         s1.to_str().unwrap(),
     ]);
-    out(&[
-        "optimize",
-        "points",
-        "-n",
-        "64",
-        "--target",
-        "family:disks",
-        "--seed",
-        "3",
-        "-o",
-        s2.to_str().unwrap(),
-    ]);
+    let design = ["optimize", "points", "-n", "64", "--target", "family:disks"];
+    out(&[&design[..], &["--seed", "3", "-o", s2.to_str().unwrap()]].concat());
     assert_eq!(std::fs::read(&s1).unwrap(), std::fs::read(&s2).unwrap());
     // optimize points takes its starting sampler as --init or --sampler;
     // both at once are refused naming the two.
     let (i1, i2) = (dir.join("i1.csv"), dir.join("i2.csv"));
     for (flag, path) in [("--init", &i1), ("--sampler", &i2)] {
-        out(&[
-            "optimize",
-            "points",
-            "-n",
-            "64",
-            "--target",
-            "family:disks",
-            "--iters",
-            "5",
-            flag,
-            "jitter",
-            "-o",
-            path.to_str().unwrap(),
-        ]);
+        let start = [flag, "jitter", "--iters", "5", "-o", path.to_str().unwrap()];
+        out(&[&design[..], &start].concat());
     }
     assert_eq!(std::fs::read(&i1).unwrap(), std::fs::read(&i2).unwrap());
     common::assert_fails(
         &[
-            "optimize",
-            "points",
-            "-n",
-            "64",
-            "--target",
-            "family:disks",
-            "--init",
-            "cmj",
-            "--sampler",
-            "jitter",
-            "-o",
-            "x.csv",
-        ],
+            &design[..],
+            &["--init", "cmj", "--sampler", "jitter", "-o", "x.csv"],
+        ]
+        .concat(),
         "'--init <SAMPLER>' cannot be used with '--sampler <SAMPLER>'",
     );
     // integrands lists names; --list adds the parameters.

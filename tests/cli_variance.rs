@@ -723,16 +723,19 @@ fn unshifted_predict_on_a_file_takes_each_set_once() {
 /// claimed −1.5 while measuring −0.99); a near-square N keeps both quiet.
 #[test]
 fn thin_multi_jittered_grids_are_named_and_get_no_theory_rate() {
-    let thin = common::varspec_ok(&[
-        "converge",
-        "--sampler",
-        "cmj",
-        "--integrand",
-        "disk:r=0.3",
-        "-n",
-        "61,251",
-        "--json",
-    ]);
+    let converge = |ns: &str| {
+        common::varspec_ok(&[
+            "converge",
+            "--sampler",
+            "cmj",
+            "--integrand",
+            "disk:r=0.3",
+            "-n",
+            ns,
+            "--json",
+        ])
+    };
+    let thin = converge("61,251");
     let v: serde_json::Value = serde_json::from_slice(&thin.stdout).unwrap();
     assert!(v["theory"].is_null(), "{v}");
     let note = String::from_utf8_lossy(&thin.stderr);
@@ -740,16 +743,7 @@ fn thin_multi_jittered_grids_are_named_and_get_no_theory_rate() {
         note.contains("cmj N = 251 is a 1 x 251 grid") && note.contains("cmj N = 61 is a 1 x 61"),
         "{note}"
     );
-    let square = common::varspec_ok(&[
-        "converge",
-        "--sampler",
-        "cmj",
-        "--integrand",
-        "disk:r=0.3",
-        "-n",
-        "64,256",
-        "--json",
-    ]);
+    let square = converge("64,256");
     let v: serde_json::Value = serde_json::from_slice(&square.stdout).unwrap();
     assert_eq!(v["theory"], -1.5, "{v}");
     assert!(!String::from_utf8_lossy(&square.stderr).contains("grid"));
