@@ -59,6 +59,21 @@ fn csv_with_set_column_splits_realizations() {
     let sets = parse("set,x0,x1\n0,0.1,0.2\n0,0.3,0.4\n1,0.5,0.6\n").unwrap();
     assert_eq!(sets.len(), 2);
     assert_eq!(sets[1].coords(), &[0.5, 0.6]);
+    // The axes' names other tools write read as x0, x1, …; other names and
+    // orders are refused.
+    for header in ["x,y", "x,y,z", "x,y,u,v", "x,y,z,w", "set,x,y"] {
+        let dim = header.split(',').filter(|n| *n != "set").count();
+        let set = if header.starts_with("set") { "0," } else { "" };
+        let row = vec!["0.25"; dim].join(",");
+        let sets = parse(&format!("{header}\n{set}{row}\n")).unwrap();
+        assert_eq!((sets.len(), sets[0].dim()), (1, dim), "{header}");
+    }
+    for header in ["y,x", "x,y,v,u", "a,b"] {
+        let e = parse(&format!("{header}\n0.1,0.2\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("CSV header must be"), "{header}: {e}");
+    }
     let utk = parse("# comment\n0.1 0.2\n0.3 0.4\n#\n0.5\t0.6\n#\n").unwrap();
     assert_eq!(utk.len(), 2);
     assert_eq!(utk[0].coords(), &[0.1, 0.2, 0.3, 0.4]);
@@ -157,7 +172,7 @@ fn every_malformed_input_names_its_line() {
             "abc",
         ),
         (
-            "x,y\n0.1,0.2\n",
+            "y,x\n0.1,0.2\n",
             1,
             |p| matches!(p, LineProblem::Header { .. }),
             "header",

@@ -1,8 +1,9 @@
 //! Point-set files (docs/formats.md).
 //!
-//! * **CSV** — a header `x0,x1,…,x{d−1}`, optionally preceded by a `set`
-//!   column that numbers realizations 0, 1, 2, … in order; one point per
-//!   row; f64 written with round-trip precision.
+//! * **CSV** — a header `x0,x1,…,x{d−1}` (read also as the axes' names
+//!   other tools write: `x,y`, `x,y,z`, `x,y,u,v`, `x,y,z,w`), optionally
+//!   preceded by a `set` column that numbers realizations 0, 1, 2, … in
+//!   order; one point per row; f64 written with round-trip precision.
 //! * **UTK text** — the Uni(corn|form) toolkit's format (Perrier, Coeurjolly &
 //!   Ostromoukhov): whitespace-separated coordinates, one point per line, a
 //!   line starting with `#` between point sets.
@@ -119,7 +120,8 @@ impl fmt::Display for LineProblem {
         match self {
             LineProblem::Header { found } => write!(
                 f,
-                "CSV header must be `x0,x1,...` or `set,x0,x1,...`, found `{found}`"
+                "CSV header must be `x0,x1,...` (or `x,y`, `x,y,z`, `x,y,u,v`, `x,y,z,w`), \
+                 optionally after `set,`, found `{found}`"
             ),
             LineProblem::NotANumber { field, text } => {
                 write!(f, "field {field} is `{text}`, not a number")
@@ -392,11 +394,18 @@ impl Parser<'_> {
         let names: Vec<&str> = text.split(',').map(str::trim).collect();
         self.set_column = names[0] == "set";
         let coords = &names[usize::from(self.set_column)..];
-        let ok = !coords.is_empty()
-            && coords
-                .iter()
-                .enumerate()
-                .all(|(j, n)| *n == format!("x{j}"));
+        // The axes' names of 2D, 3D, light-field and 4D sets.
+        const NAMED: [&[&str]; 4] = [
+            &["x", "y"],
+            &["x", "y", "z"],
+            &["x", "y", "u", "v"],
+            &["x", "y", "z", "w"],
+        ];
+        let numbered = coords
+            .iter()
+            .enumerate()
+            .all(|(j, n)| *n == format!("x{j}"));
+        let ok = !coords.is_empty() && (numbered || NAMED.contains(&coords));
         if !ok {
             return Err(LineProblem::Header { found: quote(text) });
         }
