@@ -120,7 +120,7 @@ pub fn write_fixtures(dir: &Path) {
         ("p.csv", points.into_bytes()),
         ("long-line.csv", vec![b'0'; (1 << 20) + 10]),
         ("bom.csv", "\u{feff}x0,x1\n0.1,0.2\n".into()),
-        ("bom-bad-header.csv", "\u{feff}x,y\n0.1,0.2\n".into()),
+        ("bom-bad-header.csv", "\u{feff}a,b\n0.1,0.2\n".into()),
         ("huge-weights.csv", "k,weight\n1,1e308\n2,1e308\n".into()),
         ("bom-weights.csv", "\u{feff}k,weight\n1,1\n2,0.5\n".into()),
         ("garbage.bin", "garbage\n".into()),
