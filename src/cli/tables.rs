@@ -73,6 +73,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if let Some(shard) = a.shard {
         return draw_table_shard(&a, shard);
     }
+    // The format before any drawing: a name that says none fails at once.
+    let named = match a
+        .output
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .as_deref()
+    {
+        Some("csv") => Some(FormatArg::Csv),
+        Some("json") => Some(FormatArg::Json),
+        Some("h" | "hpp") => Some(FormatArg::CHeader),
+        _ => None,
+    };
+    let format = a.format.or(named).with_context(|| {
+        format!(
+            "--format is needed: {} does not name one (.csv, .json, .h); f32 and f64 are \
+             raw floats, named with --format",
+            a.output.display()
+        )
+    })?;
     let mut run_params = a.draw.params.clone();
     let mut run_seed = a.draw.seed();
     let mut run_sampler = a.sampler.clone();
@@ -110,24 +129,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         (None, None) => bail!("give --sampler or --from"),
     };
-    let named = match a
-        .output
-        .extension()
-        .map(|e| e.to_string_lossy().to_lowercase())
-        .as_deref()
-    {
-        Some("csv") => Some(FormatArg::Csv),
-        Some("json") => Some(FormatArg::Json),
-        Some("h" | "hpp") => Some(FormatArg::CHeader),
-        _ => None,
-    };
-    let format = a.format.or(named).with_context(|| {
-        format!(
-            "--format is needed: {} does not name one (.csv, .json, .h); f32 and f64 are \
-             raw floats, named with --format",
-            a.output.display()
-        )
-    })?;
     let format = match format {
         FormatArg::Csv => TableFormat::Csv,
         FormatArg::Json => TableFormat::Json,
