@@ -259,3 +259,13 @@ pub fn count(text: &str) -> Result<usize, String> {
         )),
     }
 }
+
+/// Prints a sampler's caveat ([`varspec::samplers::Sampler::caveat`]) as a
+/// note on standard error; whether it had one.
+pub fn note_caveat(sampler: &dyn varspec::samplers::Sampler) -> bool {
+    let caveat = sampler.caveat();
+    if let Some(c) = &caveat {
+        eprintln!("note: {c}");
+    }
+    caveat.is_some()
+}

@@ -184,8 +184,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     }
                     e => e.into(),
                 })?;
-                if let Some(caveat) = sampler.caveat() {
-                    eprintln!("note: {caveat}");
+                if super::args::note_caveat(sampler.as_ref()) {
                     caveats += 1;
                 }
                 let seed = varspec::rng::level_seed(a.draw.seed(), sampler.points_per_set());

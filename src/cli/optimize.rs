@@ -619,31 +619,33 @@ fn sheared_outputs(
     Ok(())
 }
 
-/// Says which files `optimize shear` wrote: `-o` and the pictures of
-/// `--png-prefix` (a pixel's also its light field's), once its results
-/// are printed; JSON output stays one document.
-fn report_shear_outputs(a: &ShearArgs, pixel: bool) {
-    if a.json {
-        return;
-    }
-    let pictures = a.png_prefix.iter().flat_map(|prefix| {
-        PLANES.iter().flat_map(move |(name, _, _)| {
-            let light_field = pixel.then(|| format!("{prefix}-f-{name}.png"));
-            [
-                Some(format!("{prefix}-{name}-before.png")),
-                Some(format!("{prefix}-{name}-after.png")),
-                light_field,
-            ]
-            .into_iter()
-            .flatten()
+/// The pictures `--png-prefix` names: per plane the sets' spectra before
+/// and after the shear, and for a scene pixel its light field's.
+fn shear_pictures(a: &ShearArgs, pixel: bool) -> Vec<std::path::PathBuf> {
+    a.png_prefix
+        .iter()
+        .flat_map(|prefix| {
+            PLANES.iter().flat_map(move |(name, _, _)| {
+                let light_field = pixel.then(|| format!("{prefix}-f-{name}.png"));
+                [
+                    Some(format!("{prefix}-{name}-before.png")),
+                    Some(format!("{prefix}-{name}-after.png")),
+                    light_field,
+                ]
+                .into_iter()
+                .flatten()
+                .map(std::path::PathBuf::from)
+            })
         })
-    });
-    super::stdout::wrote(
-        a.output
-            .iter()
-            .map(|p| p.display().to_string())
-            .chain(pictures),
-    );
+        .collect()
+}
+
+/// Says which files `optimize shear` wrote (`-o` and [`shear_pictures`]),
+/// once its results are printed; JSON output stays one document.
+fn report_shear_outputs(a: &ShearArgs, pixel: bool) {
+    if !a.json {
+        super::stdout::wrote(a.output.iter().cloned().chain(shear_pictures(a, pixel)));
+    }
 }
 
 /// `optimize shear` on a scene pixel: the candidates of its local analysis
@@ -754,20 +756,8 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::optimize::shear::checked::{CheckVerdict, check_request, search_and_check};
     use varspec::optimize::shear::shear_set;
     // The pictures --png-prefix names (a pixel also gets its light field's).
-    let pictures: Vec<std::path::PathBuf> = a
-        .png_prefix
-        .iter()
-        .flat_map(|prefix| {
-            PLANES.iter().flat_map(move |(name, _, _)| {
-                [
-                    format!("{prefix}-{name}-before.png"),
-                    format!("{prefix}-{name}-after.png"),
-                    format!("{prefix}-f-{name}.png"),
-                ]
-                .map(std::path::PathBuf::from)
-            })
-        })
-        .collect();
+    // Every picture either kind of integrand may write is checked.
+    let pictures = shear_pictures(&a, true);
     let scene_files = varspec::scene::pixel::PixelIntegrand::files_read(&a.integrand);
     args::check_outputs_beside(
         std::iter::once(a.output.as_deref()).chain(pictures.iter().map(|p| Some(p.as_path()))),

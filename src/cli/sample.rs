@@ -88,9 +88,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     );
     args::check_outputs([a.output.as_deref()])?;
     let sampler = registry::build(&name, n, a.dim, &a.params)?;
-    if let Some(caveat) = sampler.caveat() {
-        eprintln!("note: {caveat}");
-    }
+    args::note_caveat(sampler.as_ref());
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
     let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|| bar.inc(1))?;
     bar.finish_and_clear();

@@ -130,9 +130,7 @@ impl SourceArgs {
                     }
                     built => built?,
                 };
-                if let Some(caveat) = sampler.caveat() {
-                    eprintln!("note: {caveat}");
-                }
+                super::args::note_caveat(sampler.as_ref());
                 Source::Sampler {
                     sampler,
                     seed: self.draw.seed(),

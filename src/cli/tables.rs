@@ -108,9 +108,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (Some(name), _) => {
             let n = a.n.context("--sampler needs -n")?;
             let s = registry::build(name, n, a.dim, &a.draw.params)?;
-            if let Some(caveat) = s.caveat() {
-                eprintln!("note: {caveat}");
-            }
+            super::args::note_caveat(s.as_ref());
             let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =
                 samplers::generate_sets(s.as_ref(), a.draw.seed(), a.draw.sets(), &|| bar.inc(1))?;
