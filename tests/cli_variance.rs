@@ -184,7 +184,7 @@ fn predict_output_does_not_depend_on_thread_count() {
         .concat();
         let out = varspec_with(&args, Some(threads));
         let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        for k in ["fourier", "spatial", "empirical", "radial"] {
+        for k in ["expected", "fourier", "spatial", "empirical", "radial"] {
             v[k].as_object_mut().unwrap().remove("seconds");
         }
         v
@@ -749,4 +749,94 @@ fn thin_multi_jittered_grids_are_named_and_get_no_theory_rate() {
     assert!(!String::from_utf8_lossy(&square.stderr).contains("grid"));
     let sample = common::varspec_ok(&["sample", "cmj", "-n", "251", "--sets", "1"]);
     assert!(String::from_utf8_lossy(&sample.stderr).contains("restores the grid"));
+}
+
+/// White noise's per-set values spread (a relative standard error near 9%
+/// from 16 sets on a disk): without --sets, predict draws more until 5%
+/// (variance::sets), says so, and prints the closed-form expectation
+/// Var(f)/N beside them; jitter's 16 sets already reach it; --sets fixes
+/// the count; a sampler without a closed form is refused by
+/// --method expected.
+#[test]
+fn predict_draws_sets_for_its_standard_error_and_gives_closed_forms() {
+    let base = [
+        "predict",
+        "--sampler",
+        "random",
+        "-n",
+        "256",
+        "--integrand",
+        "disk:r=0.3",
+        "--method",
+        "all",
+        "--realizations",
+        "1000",
+        "--json",
+    ];
+    let out = common::varspec_ok(&base);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let area = std::f64::consts::PI * 0.09;
+    let exact = area * (1.0 - area) / 256.0;
+    let expected = v["expected"]["variance"].as_f64().unwrap();
+    assert!(
+        (expected - exact).abs() <= 1e-12 * exact,
+        "{expected} vs Var(f)/N {exact}"
+    );
+    let auto = &v["auto_sets"];
+    let sets = auto["sets"].as_u64().unwrap();
+    assert_eq!(auto["pilot"].as_u64(), Some(16));
+    assert!(
+        auto["pilot_relative_stderr"].as_f64().unwrap() > 0.05,
+        "{auto}"
+    );
+    assert!(sets > 16 && !auto["capped"].as_bool().unwrap(), "{auto}");
+    for form in ["fourier", "spatial"] {
+        let f = &v[form];
+        assert_eq!(f["sets"].as_u64(), Some(sets), "{form}");
+        let relative = f["stderr"].as_f64().unwrap() / f["variance"].as_f64().unwrap();
+        // The count aims at 5% from the pilot's estimate; the final sets'
+        // own estimate lands near it (not a bound: both are estimates).
+        assert!(relative < 0.075, "{form}: relative stderr {relative}");
+        // Against the exact value, at 99.9% (two-sided).
+        let z = (f["variance"].as_f64().unwrap() - exact) / f["stderr"].as_f64().unwrap();
+        assert!(z.abs() <= 3.29, "{form}: z = {z} over {sets} sets");
+    }
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(note.contains(&format!("drew {sets} sets for 5%")), "{note}");
+
+    let mut fixed = base.to_vec();
+    fixed.extend(["--sets", "16"]);
+    let v = json(&fixed);
+    assert!(v.get("auto_sets").is_none());
+    assert_eq!(v["spatial"]["sets"].as_u64(), Some(16));
+
+    let jitter = json(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "256",
+        "--integrand",
+        "disk:r=0.3",
+        "--method",
+        "spatial",
+        "--json",
+    ]);
+    assert_eq!(jitter["auto_sets"]["sets"].as_u64(), Some(16), "{jitter}");
+    assert!(jitter.get("expected").is_none());
+
+    common::assert_fails(
+        &[
+            "predict",
+            "--sampler",
+            "nrooks",
+            "-n",
+            "256",
+            "--integrand",
+            "disk:r=0.3",
+            "--method",
+            "expected",
+        ],
+        "needs a sampler with a closed-form expected spectrum",
+    );
 }

@@ -13,6 +13,7 @@ mod cli;
 mod cli_spectrum;
 mod cli_variance;
 mod convergence_rates;
+mod expected_predictor;
 mod experiment;
 mod faults;
 mod hard_cases;

@@ -12,13 +12,19 @@ use super::source::{SourceArgs, realization_error};
 use varspec::PointSet;
 use varspec::integrands::{self, Integrand};
 use varspec::scene::pixel::PixelIntegrand;
+use varspec::source::Source;
 use varspec::variance::{
-    DEFAULT_SHIFT_SEED, VarianceError, empirical_shifting, fourier_parts, radial_from, spatial,
+    DEFAULT_SHIFT_SEED, TARGET_RELATIVE_STDERR, VarianceError, auto_set_cap, empirical_shifting,
+    fourier_expected, fourier_parts, radial_from, sets_for_relative_stderr, spatial,
 };
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum MethodArg {
     Fourier,
+    /// The Fourier form with the sampler's closed-form expected spectrum
+    /// (2D random, jitter, regular, uniform-jitter, multijitter, cmj): no
+    /// realizations, no sampling error; part of `all` where it exists.
+    Expected,
     Spatial,
     Empirical,
     /// The radial (isotropic) form from radially averaged spectra, with its
@@ -146,11 +152,23 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.method,
             MethodArg::Fourier | MethodArg::Radial | MethodArg::All
         );
-    for (given, option) in [(a.res.is_some(), "--res"), (a.tol.is_some(), "--tol")] {
-        if given && !fourier_runs {
+    for (given, option, runs, methods) in [
+        (
+            a.res.is_some(),
+            "--res sets the Fourier box",
+            fourier_runs || (!pixel && a.method == MethodArg::Expected),
+            "fourier, expected, radial or all",
+        ),
+        (
+            a.tol.is_some(),
+            "--tol sets the Fourier box's transform",
+            fourier_runs,
+            "fourier, radial or all",
+        ),
+    ] {
+        if given && !runs {
             bail!(
-                "{option} sets the Fourier box's transform: it applies to --method fourier, \
-                 radial or all{}",
+                "{option}: it applies to --method {methods}{}",
                 if pixel {
                     " (not to a scene pixel, which only the empirical predictor takes)"
                 } else {
@@ -167,7 +185,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "--res {res}: the Fourier box |k| < K/2 needs K >= 3 (K = 3 is the 3^d box around DC)"
         );
     }
-    let source = a.source.resolve(Some(f.dim()))?;
+    let mut source = a.source.resolve(Some(f.dim()))?;
     let sets = source.count();
     // A render averages f over each pixel's set as it is drawn: a pixel's
     // variance is that of the unshifted estimator.
@@ -211,18 +229,31 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     let n = source.points_per_set();
-    let wants = |m: MethodArg| {
-        a.method == m || (a.method == MethodArg::All && (!pixel || m == MethodArg::Empirical))
+    // The closed-form expected spectrum of a 2D sampler, drawn whole.
+    let pairs = match &source {
+        Source::Sampler {
+            sampler,
+            dims: None,
+            ..
+        } if f.dim() == 2 && f.has_fourier() => sampler.pair_spectrum(),
+        _ => None,
     };
-    // The Fourier and spatial forms pass over the same realizations: draw
-    // them once (a sampler's draw can be costly, e.g. an optimized set).
-    let drawn =
-        if wants(MethodArg::Fourier) || wants(MethodArg::Spatial) || wants(MethodArg::Radial) {
-            source.realizations()?
-        } else {
-            Vec::new()
-        };
-    let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(drawn[r].clone()) };
+    if a.method == MethodArg::Expected && pairs.is_none() {
+        bail!(
+            "--method expected needs a sampler with a closed-form expected spectrum (2D random, \
+             jitter, regular, uniform-jitter, multijitter, cmj; not a file or a projection) and \
+             an integrand with Fourier coefficients; {} on {} has none: use --method fourier",
+            source.name(),
+            f.spec()
+        );
+    }
+    let closed_form = pairs.is_some();
+    let wants = |m: MethodArg| {
+        a.method == m
+            || (a.method == MethodArg::All
+                && (!pixel || m == MethodArg::Empirical)
+                && (m != MethodArg::Expected || closed_form))
+    };
     let mut out = serde_json::Map::new();
     out.insert("integrand".into(), json!(f.spec()));
     out.insert("source".into(), json!(source.name()));
@@ -242,70 +273,71 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     out.insert("estimator".into(), json!(shift.estimator()));
-    if wants(MethodArg::Fourier) || wants(MethodArg::Radial) {
-        let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
-        let half = res.saturating_sub(1) / 2;
+    if let Some(pairs) = pairs.filter(|_| wants(MethodArg::Expected)) {
+        let res = a.res.unwrap_or(256);
         let start = Instant::now();
-        let bar = progress::bar(sets as u64, "Fourier form, sets");
-        let parts = fourier_parts(
-            f.as_ref(),
-            half,
-            a.tol.unwrap_or(DEFAULT_TOLERANCE),
-            sets,
-            |r| {
-                bar.inc(1);
-                lend(r)
-            },
-        )?;
-        bar.finish_and_clear();
-        let seconds = start.elapsed().as_secs_f64();
-        if wants(MethodArg::Radial) {
-            // The radial form averages the same pass's spectrum over rings:
-            // its time is that pass plus the averaging.
-            let own = Instant::now();
-            let r = radial_from(&parts);
-            out.insert(
-                "radial".into(),
-                json!({
-                    "variance": r.variance, "anisotropy_bound": r.anisotropy_bound,
-                    "truncation_bound": r.truncation_bound, "rings": r.rings, "res": res,
-                    "seconds": seconds + own.elapsed().as_secs_f64(),
-                }),
-            );
-        }
-        let e = parts.estimate;
-        if wants(MethodArg::Fourier) {
-            out.insert(
-                "fourier".into(),
-                json!({
-                    "variance": e.variance, "truncation_bound": e.truncation_bound, "rounding_bound": e.rounding_bound, "in_box": e.in_box,
-                    "tail": e.tail, "count_term": e.count_term, "stderr": known_stderr(e.stderr, e.sets), "res": res, "sets": e.sets,
-                    "seconds": seconds,
-                }),
-            );
-        }
-    }
-    if wants(MethodArg::Spatial) {
-        let start = Instant::now();
-        let bar = progress::bar(sets as u64, "spatial form, sets");
-        // The spatial form takes its sets in order: set r starts when r are done.
-        let spatial = spatial(f.as_ref(), sets, |r| {
-            bar.set_position(r as u64);
-            lend(r)
-        });
-        bar.finish_and_clear();
-        let value = match spatial {
-            Ok(e) => json!({
-                "variance": e.variance, "stderr": known_stderr(e.stderr, e.sets),
-                "rounding_bound": e.rounding_bound,
-                "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
+        let e = fourier_expected(f.as_ref(), res.saturating_sub(1) / 2, pairs)?.estimate;
+        out.insert(
+            "expected".into(),
+            json!({
+                "variance": e.variance, "truncation_bound": e.truncation_bound,
+                "rounding_bound": e.rounding_bound, "in_box": e.in_box, "tail": e.tail,
+                "res": res, "seconds": start.elapsed().as_secs_f64(),
             }),
-            Err(e @ VarianceError::NoAutocovariance { .. }) => {
-                json!({"variance": Value::Null, "skipped": e.to_string()})
+        );
+    }
+    // The Fourier, radial and spatial forms pass over the same
+    // realizations: draw them once (a sampler's draw can be costly, e.g. an
+    // optimized set). Without --sets, a sampler's 16 sets are a pilot: when
+    // their standard error exceeds 5% of the variance the forms run again
+    // on as many sets as reach it (variance::sets).
+    let mut drawn = Vec::new();
+    if wants(MethodArg::Fourier) || wants(MethodArg::Spatial) || wants(MethodArg::Radial) {
+        drawn = source.realizations()?;
+        let relative = set_forms(&a, f.as_ref(), &drawn, &wants, &mut out)?;
+        if let (false, Source::Sampler { sets, .. }) = (a.source.sets_were_given(), &mut source) {
+            let pilot = *sets;
+            let cap = auto_set_cap(n, f.dim(), wants(MethodArg::Spatial));
+            let relative = relative.unwrap_or(0.0);
+            let count = sets_for_relative_stderr(pilot, relative, TARGET_RELATIVE_STDERR, cap);
+            if count.sets > pilot {
+                *sets = count.sets;
+                drawn = source.realizations()?;
+                set_forms(&a, f.as_ref(), &drawn, &wants, &mut out)?;
             }
-            Err(e) => return Err(anyhow!(e)),
-        };
-        out.insert("spatial".into(), value);
+            out.insert(
+                "auto_sets".into(),
+                json!({
+                    "pilot": pilot, "pilot_relative_stderr": relative,
+                    "target_relative_stderr": TARGET_RELATIVE_STDERR, "sets": count.sets,
+                    "wanted": count.wanted, "capped": count.capped(),
+                }),
+            );
+            if count.sets > pilot || count.capped() {
+                let drew = if count.capped() {
+                    format!(
+                        "drew {} sets, the most the default work allows (R·N² ≤ 2^30 point \
+                         pairs, 256 MiB of sets): --sets {} reaches {:.0}%",
+                        count.sets,
+                        count.wanted,
+                        100.0 * TARGET_RELATIVE_STDERR
+                    )
+                } else {
+                    format!(
+                        "drew {} sets for {:.0}%",
+                        count.sets,
+                        100.0 * TARGET_RELATIVE_STDERR
+                    )
+                };
+                eprintln!(
+                    "note: {pilot} sets gave a standard error of {:.1}% of the variance (this \
+                     sampler's per-set values are spread and skewed: over few sets their mean \
+                     tends to come out low together with its standard error); {drew}; --sets \
+                     fixes the count",
+                    100.0 * relative
+                );
+            }
+        }
     }
     if wants(MethodArg::Empirical) {
         let start = Instant::now();
@@ -331,10 +363,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     // A sampler's sets are those the Fourier and spatial forms pass over;
     // the empirical predictor alone draws its own realizations.
-    let drawn_label = if drawn.is_empty() && a.source.file().is_none() {
+    let drawn_label = if a.method == MethodArg::Expected {
+        "closed form, no sets".to_string()
+    } else if drawn.is_empty() && a.source.file().is_none() {
         super::stdout::counted(realizations, "realization")
     } else {
-        super::stdout::counted(sets, "set")
+        super::stdout::counted(source.count(), "set")
     };
     // An estimate is printed to the digit its standard error reaches.
     let integral = match integral_stderr {
@@ -358,6 +392,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         outln!("  estimator: {}", shift.estimator());
     }
     for (key, extra) in [
+        ("expected", "truncation_bound"),
         ("fourier", "truncation_bound"),
         ("spatial", "stderr"),
         ("empirical", "ci_low"),
@@ -378,6 +413,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 _ if v.get("skipped").is_some() => {
                     v["skipped"].as_str().unwrap_or_default().to_string()
                 }
+                "expected" => format!(
+                    "closed-form E[P_S], no sampling error  {extra} {:.2e}",
+                    v[extra].as_f64().unwrap_or(f64::NAN)
+                ),
                 // The Fourier form has both: its sampling error over the
                 // sets and the bound on its truncation.
                 "fourier" => match (v["stderr"].as_f64(), v[extra].as_f64()) {
@@ -396,6 +435,92 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// The forms that pass over the drawn sets (Fourier, radial, spatial, as
+/// `wants` asks) into `out`, returning the largest relative standard error
+/// among the Fourier and spatial values that are not zero to rounding
+/// (`None` when none is), for the automatic set count.
+fn set_forms(
+    a: &Args,
+    f: &dyn Integrand,
+    drawn: &[PointSet],
+    wants: &dyn Fn(MethodArg) -> bool,
+    out: &mut serde_json::Map<String, Value>,
+) -> anyhow::Result<Option<f64>> {
+    let sets = drawn.len();
+    let lend = |r: usize| -> Result<PointSet, VarianceError> { Ok(drawn[r].clone()) };
+    let mut relative: Option<f64> = None;
+    let mut note = |variance: f64, stderr: f64, rounding: f64, sets: usize| {
+        if sets >= 2 && variance > rounding && variance > 0.0 {
+            let r = stderr / variance;
+            relative = Some(relative.map_or(r, |m| m.max(r)));
+        }
+    };
+    if wants(MethodArg::Fourier) || wants(MethodArg::Radial) {
+        let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
+        let half = res.saturating_sub(1) / 2;
+        let start = Instant::now();
+        let bar = progress::bar(sets as u64, "Fourier form, sets");
+        let parts = fourier_parts(f, half, a.tol.unwrap_or(DEFAULT_TOLERANCE), sets, |r| {
+            bar.inc(1);
+            lend(r)
+        })?;
+        bar.finish_and_clear();
+        let seconds = start.elapsed().as_secs_f64();
+        if wants(MethodArg::Radial) {
+            // The radial form averages the same pass's spectrum over rings:
+            // its time is that pass plus the averaging.
+            let own = Instant::now();
+            let r = radial_from(&parts);
+            out.insert(
+                "radial".into(),
+                json!({
+                    "variance": r.variance, "anisotropy_bound": r.anisotropy_bound,
+                    "truncation_bound": r.truncation_bound, "rings": r.rings, "res": res,
+                    "seconds": seconds + own.elapsed().as_secs_f64(),
+                }),
+            );
+        }
+        let e = parts.estimate;
+        note(e.variance, e.stderr, e.rounding_bound, e.sets);
+        if wants(MethodArg::Fourier) {
+            out.insert(
+                "fourier".into(),
+                json!({
+                    "variance": e.variance, "truncation_bound": e.truncation_bound, "rounding_bound": e.rounding_bound, "in_box": e.in_box,
+                    "tail": e.tail, "count_term": e.count_term, "stderr": known_stderr(e.stderr, e.sets), "res": res, "sets": e.sets,
+                    "seconds": seconds,
+                }),
+            );
+        }
+    }
+    if wants(MethodArg::Spatial) {
+        let start = Instant::now();
+        let bar = progress::bar(sets as u64, "spatial form, sets");
+        // The spatial form takes its sets in order: set r starts when r are done.
+        let spatial = spatial(f, sets, |r| {
+            bar.set_position(r as u64);
+            lend(r)
+        });
+        bar.finish_and_clear();
+        let value = match spatial {
+            Ok(e) => {
+                note(e.variance, e.stderr, e.rounding_bound, e.sets);
+                json!({
+                "variance": e.variance, "stderr": known_stderr(e.stderr, e.sets),
+                "rounding_bound": e.rounding_bound,
+                "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
+                })
+            }
+            Err(e @ VarianceError::NoAutocovariance { .. }) => {
+                json!({"variance": Value::Null, "skipped": e.to_string()})
+            }
+            Err(e) => return Err(anyhow!(e)),
+        };
+        out.insert("spatial".into(), value);
+    }
+    Ok(relative)
 }
 
 /// `predict --family`: the unshifted estimator's MSE over a family of

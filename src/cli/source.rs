@@ -49,6 +49,11 @@ impl SourceArgs {
         self.draw.seed()
     }
 
+    /// Whether --sets was given.
+    pub fn sets_were_given(&self) -> bool {
+        self.draw.sets_were_given()
+    }
+
     /// True when a point-set file or a sampler was given.
     pub fn given(&self) -> bool {
         self.points.is_some() || self.points_flag.is_some() || self.sampler.is_some()

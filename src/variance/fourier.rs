@@ -56,6 +56,7 @@ use rayon::prelude::*;
 use super::VarianceError;
 use crate::integrands::Integrand;
 use crate::points::PointSet;
+use crate::spectrum::pair::PairSpectrum;
 use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power_with};
 use crate::sum::NeumaierSum;
 
@@ -88,7 +89,7 @@ pub struct FourierEstimate {
     pub count_term: f64,
     /// The box half-width h.
     pub half: usize,
-    /// Realizations averaged.
+    /// Realizations averaged (0 for a closed-form expected spectrum).
     pub sets: usize,
 }
 
@@ -220,6 +221,80 @@ where
         &in_box_of,
         &|| {},
     )?;
+    let counts = counts.into_inner().expect("no panics while held");
+    Ok(assemble(
+        f, tolerance, pf, spectrum, intensity, &counts, &per_set,
+    ))
+}
+
+/// The Fourier form with the sampler's closed-form expected power
+/// E[N·P_S(k)] = 1 + C(k, k)/N ([`PairSpectrum`]: random, jitter,
+/// multi-jitter and CMJ in 2D) in place of realizations: the expectation
+/// Σ_(k≠0) E[P_S(k)]·P_f(k) of Pilleboue et al. 2015, Eq. (9), itself, with
+/// no sampling error (`stderr` 0, `sets` 0), and the same Parseval tail,
+/// whose bound now reads an exact shell.
+///
+/// # Errors
+/// [`VarianceError::NoFourier`] for an integrand without Fourier
+/// coefficients, [`VarianceError::Dimension`] for one that is not 2D, and
+/// a box too large for memory.
+pub fn fourier_expected(
+    f: &dyn Integrand,
+    half: usize,
+    pairs: &dyn PairSpectrum,
+) -> Result<FourierParts, VarianceError> {
+    if !f.has_fourier() {
+        return Err(VarianceError::NoFourier { spec: f.spec() });
+    }
+    if f.dim() != 2 {
+        return Err(VarianceError::Dimension {
+            integrand: f.dim(),
+            points: 2,
+        });
+    }
+    let n = pairs.points();
+    if n == 0 {
+        return Err(VarianceError::NoPoints {
+            what: "the Fourier predictor",
+        });
+    }
+    let freqs = FrequencyBox { dim: 2, half };
+    crate::spectrum::nufft::check_nufft_memory(&freqs)?;
+    let pf = integrand_power(f, &freqs);
+    let power: Vec<f64> = (0..freqs.len())
+        .into_par_iter()
+        .map_init(
+            || vec![0i64; 2],
+            |k, idx| {
+                freqs.frequency(idx, k);
+                pairs.power([k[0] as f64, k[1] as f64])
+            },
+        )
+        .collect();
+    let spectrum = Spectrum {
+        freqs,
+        power,
+        sets: 0,
+    };
+    Ok(assemble(f, 0.0, pf, spectrum, n as f64, &[n], &[]))
+}
+
+/// The prediction from the expected power on the box: the in-box sum, the
+/// Parseval tail and its bound, the rounding bound, and the standard error
+/// from the per-set in-box sums `per_set` (none for a closed form: 0).
+/// `counts` holds every set's N (one entry, N, for a closed form).
+#[allow(clippy::too_many_arguments)]
+fn assemble(
+    f: &dyn Integrand,
+    tolerance: f64,
+    pf: Vec<f64>,
+    spectrum: Spectrum,
+    intensity: f64,
+    counts: &[usize],
+    per_set: &[f64],
+) -> FourierParts {
+    let freqs = spectrum.freqs;
+    let half = freqs.half;
     let zero = freqs.zero_index();
     let (mut in_box, mut mass) = (NeumaierSum::default(), NeumaierSum::default());
     // Shell statistics of δ = power − 1 (two passes) and max P_f there.
@@ -246,9 +321,8 @@ where
         }
     }
     let nf = intensity;
-    let counts = counts.into_inner().expect("no panics while held");
     let count_bias = |c: usize| super::count_term(c, intensity, f.integral());
-    let count_term = crate::sum::sum(counts.iter().map(|&c| count_bias(c))) / sets as f64;
+    let count_term = crate::sum::sum(counts.iter().map(|&c| count_bias(c))) / counts.len() as f64;
     let tail_mass = (f.variance() - mass.value()).max(0.0);
     let (bias, spread, pf_max) = if shell.is_empty() {
         (1.0, 0.0, 0.0)
@@ -297,11 +371,17 @@ where
     // Per-set values (in-box part and count term) for the standard error.
     let per_set: Vec<f64> = per_set
         .iter()
-        .zip(&counts)
+        .zip(counts)
         .map(|(v, &c)| v / nf + count_bias(c))
         .collect();
-    let (_, stderr) = crate::sum::mean_and_stderr(&per_set);
-    Ok(FourierParts {
+    // A closed form has no per-set values and no sampling error.
+    let stderr = if per_set.is_empty() {
+        0.0
+    } else {
+        crate::sum::mean_and_stderr(&per_set).1
+    };
+    let sets = spectrum.sets;
+    FourierParts {
         estimate: FourierEstimate {
             variance: in_box + tail + count_term,
             stderr,
@@ -316,5 +396,5 @@ where
         spectrum,
         integrand_power: pf,
         intensity,
-    })
+    }
 }

@@ -14,6 +14,7 @@ pub mod fourier;
 pub mod measure;
 pub mod paired;
 pub mod radial;
+pub mod sets;
 pub mod spatial;
 
 pub use convergence::{SlopeError, SlopeFit, fit_slope, theoretical_rate};
@@ -21,12 +22,15 @@ pub use empirical::{
     DEFAULT_SHIFT_SEED, EmpiricalEstimate, NORMAL_95, empirical, empirical_shifting,
     shifted_estimates,
 };
-pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_parts};
+pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_expected, fourier_parts};
 pub use measure::{
     SamplerVariance, VarianceForm, fourier_half, sampler_variance, zero_to_rounding,
 };
 pub use paired::{VarianceRatio, paired_ratio};
 pub use radial::{RadialEstimate, radial_from};
+pub use sets::{
+    MAX_AUTO_SETS, SetCount, TARGET_RELATIVE_STDERR, auto_set_cap, sets_for_relative_stderr,
+};
 pub use spatial::{SpatialEstimate, spatial, spatial_variance};
 
 use crate::samplers::SamplerError;

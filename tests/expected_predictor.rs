@@ -1,0 +1,90 @@
+//! The Fourier form with a sampler's closed-form expected spectrum
+//! (`variance::fourier_expected`, `predict --method expected`) against
+//! values it does not compute: white noise's Var(f)/N from the disk's area
+//! alone, and the exact spatial form averaged over many realizations of the
+//! stratified samplers (an independent path: pair distances and the
+//! integrand's autocovariance, no spectrum and no pair-sum algebra).
+
+use varspec::integrands;
+use varspec::registry;
+use varspec::rng::set_rng;
+use varspec::variance::{VarianceError, fourier_expected, spatial};
+
+/// Two-sided normal quantile of 99.9%.
+const Z999: f64 = 3.29;
+
+#[test]
+fn white_noise_expectation_is_the_integrand_variance_over_n() {
+    // E[N·P_S(k)] = 1 at every k ≠ 0, so the prediction is Var(f)/N; a
+    // disk of radius r has Var(f) = πr²(1 − πr²).
+    for (r, n) in [(0.3, 1024), (0.05, 64), (0.45, 7)] {
+        let f = integrands::parse(&format!("disk:r={r}")).unwrap();
+        let random = registry::build("random", n, Some(2), &[]).unwrap();
+        let e = fourier_expected(f.as_ref(), 127, random.pair_spectrum().unwrap())
+            .unwrap()
+            .estimate;
+        let area = std::f64::consts::PI * r * r;
+        let exact = area * (1.0 - area) / n as f64;
+        assert!(
+            (e.variance - exact).abs() <= 1e-12 * exact,
+            "disk r={r}, N={n}: {} vs Var(f)/N = {exact}",
+            e.variance
+        );
+        assert!(e.truncation_bound <= 1e-12 * exact, "{e:?}");
+        assert_eq!((e.stderr, e.sets), (0.0, 0));
+    }
+}
+
+#[test]
+fn stratified_expectations_match_the_spatial_form_over_realizations() {
+    // 2000 sets of 64 (or 60: a 6 × 10 grid) points; a disk, a rotated box
+    // and a Gaussian, whose spectra weigh the axes, diagonals and the
+    // low frequencies differently.
+    let sets = 2000;
+    for (name, n) in [
+        ("jitter", 64),
+        ("multijitter", 64),
+        ("multijitter", 60),
+        ("cmj", 64),
+        ("cmj", 60),
+        ("uniform-jitter", 64),
+    ] {
+        let sampler = registry::build(name, n, Some(2), &[]).unwrap();
+        for spec in [
+            "disk:r=0.3,cx=0.41",
+            "box:w=0.5,h=0.3,angle=30",
+            "gaussian:sx=0.08,sy=0.15",
+        ] {
+            let f = integrands::parse(spec).unwrap();
+            let e = fourier_expected(f.as_ref(), 127, sampler.pair_spectrum().unwrap())
+                .unwrap()
+                .estimate;
+            let s = spatial(f.as_ref(), sets, |r| -> Result<_, VarianceError> {
+                Ok(sampler.sample(&mut set_rng(11, r as u64))?)
+            })
+            .unwrap();
+            let allowed = Z999 * s.stderr + e.truncation_bound + e.rounding_bound;
+            assert!(
+                (e.variance - s.variance).abs() <= allowed,
+                "{name} N={n} {spec}: closed form {:.6e} vs spatial {:.6e} ± {:.2e} \
+                 ({sets} sets; 99.9% interval ± {:.2e} with the truncation bound {:.2e})",
+                e.variance,
+                s.variance,
+                s.stderr,
+                allowed,
+                e.truncation_bound
+            );
+        }
+    }
+}
+
+#[test]
+fn integrands_without_a_spectrum_or_in_4d_are_refused() {
+    let random = registry::build("random", 64, Some(2), &[]).unwrap();
+    let pairs = random.pair_spectrum().unwrap();
+    let defocus = integrands::parse("defocus:shape=disk,size=0.3,c=0.5").unwrap();
+    assert!(matches!(
+        fourier_expected(defocus.as_ref(), 15, pairs),
+        Err(VarianceError::Dimension { integrand: 4, .. })
+    ));
+}
