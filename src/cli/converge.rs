@@ -322,16 +322,29 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 (ns[ns.len() - 1], v0 * (ns[ns.len() - 1] / n0).powf(slope)),
             ]
         };
+        // Each level's 95% interval (normal, from its standard error over
+        // the sets or members); none where one set left it unknown.
+        let z = varspec::variance::NORMAL_95;
+        let bars = points
+            .iter()
+            .map(|p| {
+                p.stderr.map_or((p.variance, p.variance), |e| {
+                    (p.variance - z * e, p.variance + z * e)
+                })
+            })
+            .collect();
         let mut series = vec![Series {
-            label: format!("{label} (slope {:.3})", fit.slope),
+            label: format!("{label} (slope {:.3}; bars: 95% CI)", fit.slope),
             points: ns.iter().copied().zip(vars.iter().copied()).collect(),
             reference: false,
+            error_bars: bars,
         }];
         for s in [-1.0, -1.5, -2.0, -3.0] {
             series.push(Series {
                 label: format!("N^{s}"),
                 points: line(s),
                 reference: true,
+                error_bars: Vec::new(),
             });
         }
         let plot = LinePlot {

@@ -892,11 +892,13 @@ fn design_outputs(
             label: "optimized (set 0)".into(),
             points: curve.clone(),
             reference: false,
+            error_bars: Vec::new(),
         })
         .chain(baselines.iter().map(|&(name, score)| Series {
             label: name.into(),
             points: vec![(t0, score), (t1, score)],
             reference: true,
+            error_bars: Vec::new(),
         }))
         .collect();
         let plot = LinePlot {

@@ -143,11 +143,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         .zip(pcf.g.iter().copied())
                         .collect(),
                     reference: false,
+                    error_bars: Vec::new(),
                 },
                 Series {
                     label: "white noise".into(),
                     points: vec![(0.0, 1.0), (range, 1.0)],
                     reference: true,
+                    error_bars: Vec::new(),
                 },
             ],
         };

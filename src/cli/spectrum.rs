@@ -246,11 +246,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     .map(|b| (b.k as f64, b.power))
                     .collect(),
                 reference: false,
+                error_bars: Vec::new(),
             })
             .chain(a.integrand.is_none().then(|| Series {
                 label: "white noise".into(),
                 points: vec![(1.0, 1.0), (freqs.half as f64, 1.0)],
                 reference: true,
+                error_bars: Vec::new(),
             }))
             .collect(),
         };

@@ -677,6 +677,7 @@ impl FigureExperiment {
                             .map(|b| (b.k as f64, b.power))
                             .collect(),
                         reference: false,
+                        error_bars: Vec::new(),
                     });
                 }
                 let plot = LinePlot {
@@ -946,6 +947,7 @@ impl FigureExperiment {
                             label: format!("unsheared (slope {sb:.2})"),
                             points: before,
                             reference: false,
+                            error_bars: Vec::new(),
                         },
                         Series {
                             label: format!(
@@ -954,6 +956,7 @@ impl FigureExperiment {
                             ),
                             points: after,
                             reference: false,
+                            error_bars: Vec::new(),
                         },
                     ],
                 };

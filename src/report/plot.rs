@@ -41,6 +41,10 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Dashed reference line rather than data.
     pub reference: bool,
+    /// A vertical interval (low, high) per point, drawn as an error bar
+    /// with caps; empty for none. A low end at or below zero on a log axis
+    /// runs to the bottom of the plot.
+    pub error_bars: Vec<(f64, f64)>,
 }
 
 /// A line plot with labelled axes, optionally log-log.
@@ -116,29 +120,31 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
     macro_rules! finish {
         ($chart:expr) => {{
             let mut chart = $chart;
+            // Log axes label only their key points (log_axis_ticks): N as
+            // a number, values as m·10^e.
             let axis_number = |v: &f64| {
                 if plot.log_log {
-                    let e = v.abs().log10();
-                    if (e - e.round()).abs() < 1e-9 {
-                        format!("1e{}", e.round())
+                    // A tick m·10^e computed as such: its log10 can fall
+                    // a rounding below e.
+                    let e = (v.abs().log10() + 1e-9).floor();
+                    let m = (v / 10f64.powf(e)).round();
+                    if m == 1.0 {
+                        format!("1e{e}")
                     } else {
-                        String::new()
+                        format!("{m}e{e}")
                     }
                 } else {
                     format!("{}", (v * 1e6).round() / 1e6)
                 }
             };
-            // On a log axis label only 1, 2 and 5 times powers of ten.
             let x_number = |v: &f64| {
                 if !plot.log_log {
                     return axis_number(v);
                 }
-                let mantissa = v / 10f64.powf(v.log10().floor());
-                let shown = [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-6);
-                match shown {
-                    false => String::new(),
-                    true if *v >= 10.0 => format!("{}", v.round()),
-                    true => format!("{}", (v * 1e4).round() / 1e4),
+                if *v >= 10.0 {
+                    format!("{}", v.round())
+                } else {
+                    format!("{}", (v * 1e4).round() / 1e4)
                 }
             };
             chart
@@ -168,6 +174,13 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
                         .draw_series(DashedLineSeries::new(data, 6, 4, style))
                         .map_err(draw_error)?
                 } else {
+                    // Error bars first, under the markers; a low end that a
+                    // log axis cannot show runs to its bottom.
+                    let bars = data.iter().zip(&s.error_bars).map(|(&(x, y), &(lo, hi))| {
+                        let lo = if finite(lo) { lo } else { y0 };
+                        ErrorBar::new_vertical(x, lo.max(y0), y, hi.min(y1), style, 8)
+                    });
+                    chart.draw_series(bars).map_err(draw_error)?;
                     // Markers on the data, so measured points stand out from
                     // a reference line running through them.
                     chart
@@ -186,15 +199,28 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
                 .label_font(("sans-serif", 15))
                 .background_style(WHITE.mix(0.85))
                 .border_style(RGBColor(160, 160, 160))
-                .position(SeriesLabelPosition::UpperRight)
+                .position(legend_corner(plot, (x0, x1), (y0, y1)))
                 .draw()
                 .map_err(draw_error)?;
         }};
     }
     if plot.log_log {
+        // Own key points: plotters' log axis repeats a decade's first
+        // value from the decade below (two "1000" labels) and bunches its
+        // light lines there.
+        let (x_bold, x_light) = log_axis_ticks(x0, x1, false);
+        let (y_bold, y_light) = log_axis_ticks(y0, y1, true);
+        let x_axis = (x0..x1)
+            .log_scale()
+            .with_key_points(x_bold)
+            .with_light_points(x_light);
+        let y_axis = (y0..y1)
+            .log_scale()
+            .with_key_points(y_bold)
+            .with_light_points(y_light);
         finish!(
             builder
-                .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+                .build_cartesian_2d(x_axis, y_axis)
                 .map_err(draw_error)?
         );
     } else {
@@ -205,6 +231,96 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
         );
     }
     root.present().map_err(draw_error)
+}
+
+/// The corner of the plot area whose legend-sized box (40% of the width,
+/// 30% of the height) covers the fewest samples of the curves, each
+/// segment sampled at 16 points in plot coordinates (log for a log-log
+/// plot); the upper right on ties.
+fn legend_corner(plot: &LinePlot, x: (f64, f64), y: (f64, f64)) -> SeriesLabelPosition {
+    let scale = |v: f64, (lo, hi): (f64, f64)| {
+        if plot.log_log {
+            (v.ln() - lo.ln()) / (hi.ln() - lo.ln())
+        } else {
+            (v - lo) / (hi - lo)
+        }
+    };
+    let mut samples = Vec::new();
+    for s in &plot.series {
+        let p: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .map(|&(a, b)| (scale(a, x), scale(b, y)))
+            .filter(|(a, b)| a.is_finite() && b.is_finite())
+            .collect();
+        samples.extend(p.iter().copied());
+        for w in p.windows(2) {
+            samples.extend((1..16).map(|i| {
+                let t = f64::from(i) / 16.0;
+                (
+                    w[0].0 + t * (w[1].0 - w[0].0),
+                    w[0].1 + t * (w[1].1 - w[0].1),
+                )
+            }));
+        }
+    }
+    let covered = |right: bool, upper: bool| {
+        samples
+            .iter()
+            .filter(|&&(a, b)| {
+                (if right { a >= 0.6 } else { a <= 0.4 })
+                    && (if upper { b >= 0.7 } else { b <= 0.3 })
+            })
+            .count()
+    };
+    [
+        (SeriesLabelPosition::UpperRight, covered(true, true)),
+        (SeriesLabelPosition::UpperLeft, covered(false, true)),
+        (SeriesLabelPosition::LowerLeft, covered(false, false)),
+        (SeriesLabelPosition::LowerRight, covered(true, false)),
+    ]
+    .into_iter()
+    .min_by_key(|&(_, c)| c)
+    .map_or(SeriesLabelPosition::UpperRight, |(p, _)| p)
+}
+
+/// Labelled and light grid values of a log axis over [lo, hi]: labels at
+/// decades (`decades_first`, a value axis) or at 1, 2, 5 times them (an N
+/// axis), falling back to finer mantissas until two labels show, and to
+/// decades when 1, 2, 5 would crowd past 12; light lines at the other
+/// integer mantissas.
+fn log_axis_ticks(lo: f64, hi: f64, decades_first: bool) -> (Vec<f64>, Vec<f64>) {
+    const ALL: [f64; 9] = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0];
+    let choices: &[&[f64]] = if decades_first {
+        &[&[1.0], &[1.0, 2.0, 5.0], &ALL]
+    } else {
+        &[&[1.0, 2.0, 5.0], &ALL]
+    };
+    let mut bold = choices
+        .iter()
+        .map(|m| log_ticks(lo, hi, m))
+        .find(|t| t.len() >= 2)
+        .unwrap_or_else(|| log_ticks(lo, hi, &ALL));
+    if bold.len() > 12 {
+        bold = log_ticks(lo, hi, &[1.0]);
+    }
+    let light = log_ticks(lo, hi, &ALL)
+        .into_iter()
+        .filter(|v| !bold.contains(v))
+        .collect();
+    (bold, light)
+}
+
+/// The values m·10^e (m from `mantissas`) within [lo, hi], 0 < lo < hi,
+/// each computed from its exponent (no drift from repeated products).
+fn log_ticks(lo: f64, hi: f64, mantissas: &[f64]) -> Vec<f64> {
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let mut ticks: Vec<f64> = (first..=last)
+        .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+        .filter(|v| (lo..=hi).contains(v))
+        .collect();
+    ticks.sort_by(f64::total_cmp);
+    ticks
 }
 
 fn min_max(values: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -420,4 +536,88 @@ fn draw_heatmap_frame(
     );
     root.present().map_err(draw_error)?;
     Ok(ranges)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_ticks_are_distinct_and_exact() {
+        // Plotters' own key points gave 1000 twice over 53…4915.
+        let (bold, light) = log_axis_ticks(53.3, 4915.2, false);
+        assert_eq!(bold, vec![100.0, 200.0, 500.0, 1000.0, 2000.0]);
+        assert_eq!(light.iter().filter(|&&v| v == 1000.0).count(), 0);
+        assert!(light.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!(light.first(), Some(&60.0));
+        // A value axis labels decades; within one decade it falls back.
+        assert_eq!(log_axis_ticks(2e-9, 3e-3, true).0.len(), 6);
+        assert_eq!(
+            log_axis_ticks(1.5e-5, 9e-5, true).0,
+            vec![2e-5, 5e-5]
+        );
+        // Many decades: decades only, not 1, 2, 5 of each.
+        assert_eq!(log_axis_ticks(1.0, 1e9, false).0.len(), 10);
+    }
+
+    fn falling(error_bars: Vec<(f64, f64)>) -> LinePlot {
+        LinePlot {
+            title: "t".into(),
+            x_label: "N".into(),
+            y_label: "variance".into(),
+            log_log: true,
+            series: vec![Series {
+                label: "data".into(),
+                points: vec![(64.0, 1e-3), (256.0, 2.5e-4), (1024.0, 6e-5), (4096.0, 1.5e-5)],
+                reference: false,
+                error_bars,
+            }],
+        }
+    }
+
+    #[test]
+    fn the_legend_avoids_the_curve() {
+        // A falling curve fills the upper left and lower right.
+        let p = falling(Vec::new());
+        let position = legend_corner(&p, (50.0, 5000.0), (7e-6, 2e-3));
+        assert!(
+            matches!(
+                position,
+                SeriesLabelPosition::UpperRight | SeriesLabelPosition::LowerLeft
+            ),
+            "{position:?}"
+        );
+        let rising = LinePlot {
+            log_log: false,
+            series: vec![Series {
+                points: vec![(0.0, 0.0), (1.0, 1.0)],
+                ..p.series[0].clone()
+            }],
+            ..p
+        };
+        let position = legend_corner(&rising, (0.0, 1.0), (0.0, 1.0));
+        assert!(
+            matches!(
+                position,
+                SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerRight
+            ),
+            "{position:?}"
+        );
+    }
+
+    #[test]
+    fn error_bars_are_drawn() {
+        ensure_font();
+        let draw = |plot: &LinePlot| {
+            let mut buf = vec![255u8; 800 * 560 * 3];
+            draw_lines(plot, &mut buf, (800, 560)).unwrap();
+            buf
+        };
+        let plain = draw(&falling(Vec::new()));
+        let bars = vec![(5e-4, 2e-3), (1e-4, 5e-4), (3e-5, 1.2e-4), (-1e-5, 3e-5)];
+        let barred = draw(&falling(bars));
+        let changed = plain.iter().zip(&barred).filter(|(a, b)| a != b).count();
+        // Four bars of tens of pixels each, and caps.
+        assert!(changed > 4 * 3 * 30, "{changed} bytes changed");
+    }
 }

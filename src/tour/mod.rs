@@ -446,6 +446,7 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
                 .map(|b| (b.k as f64, b.power))
                 .collect(),
             reference: false,
+            error_bars: Vec::new(),
         });
     }
     let jitter = rows[1].spatial;
