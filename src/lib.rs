@@ -51,6 +51,7 @@ pub mod source;
 pub mod spec_params;
 pub mod spectrum;
 pub mod square;
+pub mod suggest;
 pub mod sum;
 pub mod tables;
 pub mod tour;

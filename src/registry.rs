@@ -291,6 +291,12 @@ pub fn find(name: &str) -> Result<&'static SamplerInfo, SamplerError> {
         .find(|s| s.name == name || s.aliases.contains(&name))
         .ok_or_else(|| SamplerError::Unknown {
             name: name.to_string(),
+            suggestion: crate::suggest::did_you_mean(
+                name,
+                SAMPLERS
+                    .iter()
+                    .flat_map(|s| std::iter::once(s.name).chain(s.aliases.iter().copied())),
+            ),
             known: SAMPLERS
                 .iter()
                 .map(|s| s.name)
@@ -389,6 +395,7 @@ pub fn build(
         return Err(SamplerError::UnknownParam {
             sampler,
             key: key.clone(),
+            suggestion: crate::suggest::did_you_mean(key, known.iter().copied()),
             known: if known.is_empty() {
                 "none".into()
             } else {

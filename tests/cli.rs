@@ -159,6 +159,43 @@ fn bad_requests_fail_with_a_specific_message() {
             "jitter in 4D: N = 200 does not fit",
         ),
         (vec!["sample", "nope", "-n", "10"], "known samplers: random"),
+        // A close miss names what was meant (src/suggest.rs); a far one not.
+        (
+            vec!["sample", "poison-disk", "-n", "10"],
+            "unknown sampler `poison-disk` (did you mean `poisson-disk`?); known samplers",
+        ),
+        (
+            vec!["sample", "Sobol", "-n", "10"],
+            "(did you mean `sobol`?)",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "16",
+                "--integrand",
+                "gausian",
+            ],
+            "unknown integrand `gausian` (did you mean `gaussian`?)",
+        ),
+        (
+            vec![
+                "predict",
+                "--sampler",
+                "jitter",
+                "-n",
+                "16",
+                "--integrand",
+                "box:angel=3",
+            ],
+            "unknown parameter `angel` (did you mean `angle`?)",
+        ),
+        (
+            vec!["render", "shadows-sqare", "-o", "never.png"],
+            "no scene `shadows-sqare` (did you mean `shadows-square`?)",
+        ),
         (
             vec!["sample", "cmj", "-n", "10", "-d", "3"],
             "dimension 3 is not supported",

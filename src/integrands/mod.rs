@@ -90,20 +90,24 @@ pub struct IntegrandClass {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum IntegrandError {
     /// No integrand of that name.
-    #[error("unknown integrand `{name}`; known: {known}")]
+    #[error("unknown integrand `{name}`{suggestion}; known: {known}")]
     Unknown {
         /// The name.
         name: String,
+        /// " (did you mean `…`?)" or empty ([`crate::suggest`]).
+        suggestion: String,
         /// Known names.
         known: String,
     },
     /// A key the integrand does not take.
-    #[error("{integrand}: unknown parameter `{key}`; its parameters: {known}")]
+    #[error("{integrand}: unknown parameter `{key}`{suggestion}; its parameters: {known}")]
     UnknownKey {
         /// Integrand name.
         integrand: &'static str,
         /// The key.
         key: String,
+        /// " (did you mean `…`?)" or empty ([`crate::suggest`]).
+        suggestion: String,
         /// Its keys.
         known: String,
     },

@@ -214,6 +214,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
             .find(|i| i.name == name)
             .ok_or_else(|| IntegrandError::Unknown {
                 name: name.to_string(),
+                suggestion: crate::suggest::did_you_mean(name, INTEGRANDS.iter().map(|i| i.name)),
                 known: INTEGRANDS
                     .iter()
                     .map(|i| i.name)
@@ -230,6 +231,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
             return Err(IntegrandError::UnknownKey {
                 integrand: info.name,
                 key: k.to_string(),
+                suggestion: crate::suggest::did_you_mean(k, info.params.iter().map(|p| p.0)),
                 known: info
                     .params
                     .iter()

@@ -74,9 +74,13 @@ impl Target {
                      `A+2*B`) or of a 4D projection target (`xy:A;2*uv:B`); a lone target takes none"
                 )))
             }
-            Err(integrands::IntegrandError::Unknown { name, known }) => Err(fail(format!(
-                "`{name}` is neither an integrand ({known}) nor family:disks, power:A or \
-                 radial:FILE.csv"
+            Err(integrands::IntegrandError::Unknown {
+                name,
+                known,
+                suggestion,
+            }) => Err(fail(format!(
+                "`{name}`{suggestion} is neither an integrand ({known}) nor family:disks, \
+                 power:A or radial:FILE.csv"
             ))),
             Err(e) => Err(e.into()),
         }

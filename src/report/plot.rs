@@ -552,10 +552,7 @@ mod tests {
         assert_eq!(light.first(), Some(&60.0));
         // A value axis labels decades; within one decade it falls back.
         assert_eq!(log_axis_ticks(2e-9, 3e-3, true).0.len(), 6);
-        assert_eq!(
-            log_axis_ticks(1.5e-5, 9e-5, true).0,
-            vec![2e-5, 5e-5]
-        );
+        assert_eq!(log_axis_ticks(1.5e-5, 9e-5, true).0, vec![2e-5, 5e-5]);
         // Many decades: decades only, not 1, 2, 5 of each.
         assert_eq!(log_axis_ticks(1.0, 1e9, false).0.len(), 10);
     }
@@ -568,7 +565,12 @@ mod tests {
             log_log: true,
             series: vec![Series {
                 label: "data".into(),
-                points: vec![(64.0, 1e-3), (256.0, 2.5e-4), (1024.0, 6e-5), (4096.0, 1.5e-5)],
+                points: vec![
+                    (64.0, 1e-3),
+                    (256.0, 2.5e-4),
+                    (1024.0, 6e-5),
+                    (4096.0, 1.5e-5),
+                ],
                 reference: false,
                 error_bars,
             }],

@@ -80,10 +80,12 @@ pub trait Sampler: Send + Sync {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SamplerError {
     /// No sampler has this name.
-    #[error("unknown sampler `{name}`; known samplers: {known}")]
+    #[error("unknown sampler `{name}`{suggestion}; known samplers: {known}")]
     Unknown {
         /// The name given.
         name: String,
+        /// " (did you mean `…`?)" or empty ([`crate::suggest`]).
+        suggestion: String,
         /// Every known name.
         known: String,
     },
@@ -154,12 +156,14 @@ pub enum SamplerError {
         key: String,
     },
     /// A parameter the sampler does not have.
-    #[error("{sampler}: unknown parameter `{key}`; its parameters: {known}{hint}")]
+    #[error("{sampler}: unknown parameter `{key}`{suggestion}; its parameters: {known}{hint}")]
     UnknownParam {
         /// Sampler name.
         sampler: &'static str,
         /// The key given.
         key: String,
+        /// " (did you mean `…`?)" or empty ([`crate::suggest`]).
+        suggestion: String,
         /// The sampler's keys.
         known: String,
         /// Where the key may have come from (empty if nowhere likely).

@@ -291,10 +291,12 @@ pub enum SceneError {
         expected: String,
     },
     /// No built-in scene and no file of that name.
-    #[error("no scene `{name}`: neither a built-in scene ({known}) nor a file")]
+    #[error("no scene `{name}`{suggestion}: neither a built-in scene ({known}) nor a file")]
     Unknown {
         /// The name given.
         name: String,
+        /// " (did you mean `…`?)" or empty ([`crate::suggest`]).
+        suggestion: String,
         /// The built-in names.
         known: String,
     },

@@ -178,6 +178,10 @@ impl Scene {
         if !path.exists() {
             return Err(SceneError::Unknown {
                 name: name_or_path.into(),
+                suggestion: crate::suggest::did_you_mean(
+                    name_or_path,
+                    BUILTIN_SCENES.iter().map(|s| s.0),
+                ),
                 known: BUILTIN_SCENES.map(|s| s.0).join(", "),
             });
         }
