@@ -840,3 +840,47 @@ fn predict_draws_sets_for_its_standard_error_and_gives_closed_forms() {
         "needs a sampler with a closed-form expected spectrum",
     );
 }
+
+/// --method takes a comma-separated list and runs exactly those predictors.
+#[test]
+fn predict_runs_the_listed_methods() {
+    let v = json(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "64",
+        "--integrand",
+        "disk:r=0.3",
+        "--method",
+        "spatial,empirical",
+        "--realizations",
+        "500",
+        "--json",
+    ]);
+    for (key, present) in [
+        ("spatial", true),
+        ("empirical", true),
+        ("fourier", false),
+        ("expected", false),
+        ("radial", false),
+    ] {
+        assert_eq!(v.get(key).is_some(), present, "{key}: {v}");
+    }
+    common::assert_fails(
+        &[
+            "predict",
+            "--sampler",
+            "jitter",
+            "-n",
+            "64",
+            "--integrand",
+            "disk",
+            "--method",
+            "spatial,empirical",
+            "--shift",
+            "xy",
+        ],
+        "run --method empirical alone",
+    );
+}

@@ -88,9 +88,9 @@ pub struct Args {
     /// 2, for the standard error).
     #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
     members: Option<usize>,
-    /// Which predictor(s) to run.
-    #[arg(long, value_enum, default_value_t = MethodArg::All)]
-    method: MethodArg,
+    /// Which predictor(s) to run, comma-separated (e.g. spatial,empirical).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "all")]
+    method: Vec<MethodArg>,
     /// Realizations (fresh sampler randomness and shift each) of the
     /// empirical predictor [default: 10000; a scene pixel's point file:
     /// its set count].
@@ -134,7 +134,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let pixel = PixelIntegrand::is_pixel_spec(spec);
     // A pixel's integral is an estimate: its standard error goes with it.
     let (f, integral_stderr): (Box<dyn Integrand>, Option<f64>) = if pixel {
-        if !matches!(a.method, MethodArg::Empirical | MethodArg::All) {
+        if !a
+            .method
+            .iter()
+            .all(|m| matches!(m, MethodArg::Empirical | MethodArg::All))
+        {
             bail!(
                 "{spec}: a scene pixel has no closed-form spectrum or autocovariance; \
                  predict it with --method empirical"
@@ -147,16 +151,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (integrands::parse(spec)?, None)
     };
     // Options of a predictor that will not run are refused, not ignored.
-    let fourier_runs = !pixel
-        && matches!(
-            a.method,
-            MethodArg::Fourier | MethodArg::Radial | MethodArg::All
-        );
+    let asks = |m: MethodArg| a.method.contains(&m);
+    let fourier_runs =
+        !pixel && (asks(MethodArg::Fourier) || asks(MethodArg::Radial) || asks(MethodArg::All));
     for (given, option, runs, methods) in [
         (
             a.res.is_some(),
             "--res sets the Fourier box",
-            fourier_runs || (!pixel && a.method == MethodArg::Expected),
+            fourier_runs || (!pixel && asks(MethodArg::Expected)),
             "fourier, expected, radial or all",
         ),
         (
@@ -177,7 +179,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             );
         }
     }
-    if a.realizations.is_some() && !matches!(a.method, MethodArg::Empirical | MethodArg::All) {
+    if a.realizations.is_some() && !(asks(MethodArg::Empirical) || asks(MethodArg::All)) {
         bail!("--realizations applies to the empirical predictor (--method empirical or all)");
     }
     if let Some(res) = a.res.filter(|&r| r < 3) {
@@ -202,11 +204,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         None => DEFAULT_REALIZATIONS,
     };
     if shift != ShiftArg::All {
-        if !(a.method == MethodArg::Empirical || pixel) {
+        if !(a.method.iter().all(|&m| m == MethodArg::Empirical) || pixel) {
             bail!(
                 "--shift {}: only the empirical predictor takes another shift; the Fourier, \
-                 spatial and radial forms are of the estimator shifted in every dimension: add \
-                 --method empirical",
+                 spatial and radial forms are of the estimator shifted in every dimension: run \
+                 --method empirical alone",
                 shift
                     .to_possible_value()
                     .map_or("?".into(), |v| v.get_name().to_string())
@@ -238,7 +240,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         } if f.dim() == 2 && f.has_fourier() => sampler.pair_spectrum(),
         _ => None,
     };
-    if a.method == MethodArg::Expected && pairs.is_none() {
+    if asks(MethodArg::Expected) && pairs.is_none() {
         bail!(
             "--method expected needs a sampler with a closed-form expected spectrum (2D random, \
              jitter, regular, uniform-jitter, multijitter, cmj; not a file or a projection) and \
@@ -249,8 +251,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let closed_form = pairs.is_some();
     let wants = |m: MethodArg| {
-        a.method == m
-            || (a.method == MethodArg::All
+        asks(m)
+            || (asks(MethodArg::All)
                 && (!pixel || m == MethodArg::Empirical)
                 && (m != MethodArg::Expected || closed_form))
     };
@@ -363,7 +365,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     // A sampler's sets are those the Fourier and spatial forms pass over;
     // the empirical predictor alone draws its own realizations.
-    let drawn_label = if a.method == MethodArg::Expected {
+    let drawn_label = if a.method.iter().all(|&m| m == MethodArg::Expected) {
         "closed form, no sets".to_string()
     } else if drawn.is_empty() && a.source.file().is_none() {
         super::stdout::counted(realizations, "realization")
