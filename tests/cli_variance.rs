@@ -884,3 +884,64 @@ fn predict_runs_the_listed_methods() {
         "run --method empirical alone",
     );
 }
+
+/// converge --method expected: the closed-form expectation at each N, no
+/// sets. White noise gives Var(f)/N exactly, so the slope is −1 to
+/// rounding; a sampler without a closed form and point files are refused.
+#[test]
+fn converge_with_closed_form_expectations() {
+    let v = json(&[
+        "converge",
+        "--sampler",
+        "random",
+        "--integrand",
+        "disk:r=0.3",
+        "--method",
+        "expected",
+        "--n",
+        "16,100,1000,10000",
+        "--json",
+    ]);
+    let area = std::f64::consts::PI * 0.09;
+    for p in v["points"].as_array().unwrap() {
+        let n = p["n"].as_f64().unwrap();
+        let exact = area * (1.0 - area) / n;
+        let got = p["variance"].as_f64().unwrap();
+        assert!(
+            (got - exact).abs() <= 1e-12 * exact,
+            "N = {n}: {got} vs {exact}"
+        );
+    }
+    assert!((v["slope"].as_f64().unwrap() + 1.0).abs() < 1e-9, "{v}");
+    assert_eq!(v["sets"].as_u64(), Some(0));
+    common::assert_fails(
+        &[
+            "converge",
+            "--sampler",
+            "nrooks",
+            "--integrand",
+            "disk",
+            "--method",
+            "expected",
+            "--n",
+            "16,64",
+        ],
+        "nrooks has no closed-form expected spectrum",
+    );
+    common::assert_fails(
+        &[
+            "converge",
+            "--sampler",
+            "jitter",
+            "--integrand",
+            "disk",
+            "--method",
+            "expected",
+            "--n",
+            "16,64",
+            "--sets",
+            "4",
+        ],
+        "--method expected draws no sets",
+    );
+}

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::bail;
+use anyhow::{Context, bail};
 use clap::ValueEnum;
 use serde_json::json;
 
@@ -16,7 +16,9 @@ use varspec::registry;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
 use varspec::source::Source;
 use varspec::square::{Family, family_mse};
-use varspec::variance::{VarianceForm, fit_slope, sampler_variance, theoretical_rate};
+use varspec::variance::{
+    SamplerVariance, VarianceForm, fit_slope, fourier_expected, sampler_variance, theoretical_rate,
+};
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum MethodArg {
@@ -24,6 +26,10 @@ enum MethodArg {
     Spatial,
     /// Fourier form with the Parseval tail.
     Fourier,
+    /// The Fourier form with the sampler's closed-form expected spectrum
+    /// (2D random, jitter, regular, uniform-jitter, multijitter, cmj): the
+    /// expected variance itself at each N, no sets and no sampling noise.
+    Expected,
 }
 
 #[derive(clap::Args)]
@@ -58,7 +64,8 @@ pub struct Args {
     /// Predictor (default: spatial, or fourier for integrands without c_f).
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
-    /// Fourier box |k| < K/2 for --method fourier (default 256 in 2D, 21 in 4D).
+    /// Fourier box |k| < K/2 for --method fourier or expected (default 256 in
+    /// 2D, 21 in 4D; for expected, at least 8√N + 1 at each N).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// CSV of N against variance.
@@ -152,7 +159,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         MethodArg::Fourier
     });
     if a.res.is_some() && method == MethodArg::Spatial {
-        bail!("--res sets the Fourier form's box: it applies to --method fourier");
+        bail!("--res sets the Fourier form's box: it applies to --method fourier or expected");
+    }
+    if method == MethodArg::Expected && (a.sampler.is_none() || dim != 2) {
+        bail!(
+            "--method expected takes a sampler's closed-form expected spectrum: it needs \
+             --sampler (not --points) and a 2D integrand"
+        );
+    }
+    if method == MethodArg::Expected && a.draw.sets_were_given() {
+        bail!("--sets: --method expected draws no sets (the expectation is in closed form)");
     }
     if !a.points.is_empty() && a.family.is_none() && a.draw.seed_was_given() {
         bail!(
@@ -224,17 +240,47 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 (e.mse, e.stderr, 0.0)
             }
             (Subject::Torus(f), method) => {
-                let form = match method {
-                    MethodArg::Spatial => VarianceForm::Spatial,
-                    MethodArg::Fourier => VarianceForm::Fourier {
-                        half: a.res.map_or(varspec::variance::fourier_half(dim), |r| {
-                            r.saturating_sub(1) / 2
-                        }),
-                    },
+                let half = a.res.map_or(varspec::variance::fourier_half(dim), |r| {
+                    r.saturating_sub(1) / 2
+                });
+                let e = match (method, &source) {
+                    (MethodArg::Expected, Source::Sampler { sampler, .. }) => {
+                        let pairs = sampler.pair_spectrum().with_context(|| {
+                            format!(
+                                "--method expected: {label} has no closed-form expected \
+                                 spectrum (2D random, jitter, regular, uniform-jitter, \
+                                 multijitter and cmj have one); use --method spatial"
+                            )
+                        })?;
+                        // Without --res the box grows with N, half-width
+                        // 4√N (at least the default's): a stratified set's
+                        // spectrum rises to white noise near k ≈ √N, and a
+                        // fixed box leaves that rise to the tail estimate
+                        // (cmj at N = 65,536 on a 255² box: truncation bound
+                        // 2× the value; 2049²: 5%, 3 s).
+                        let half = match a.res {
+                            Some(_) => half,
+                            None => half.max((4.0 * (n as f64).sqrt()).ceil() as usize),
+                        };
+                        let p = fourier_expected(f.as_ref(), half, pairs)?.estimate;
+                        SamplerVariance {
+                            variance: p.variance,
+                            stderr: 0.0,
+                            truncation_bound: p.truncation_bound,
+                            rounding_bound: p.rounding_bound,
+                            method: "expected",
+                        }
+                    }
+                    _ => {
+                        let form = match method {
+                            MethodArg::Spatial => VarianceForm::Spatial,
+                            _ => VarianceForm::Fourier { half },
+                        };
+                        sampler_variance(f.as_ref(), count, form, |r| {
+                            source.get(r).map_err(|e| realization_error(r, e))
+                        })?
+                    }
                 };
-                let e = sampler_variance(f.as_ref(), count, form, |r| {
-                    source.get(r).map_err(|e| realization_error(r, e))
-                })?;
                 if varspec::variance::zero_to_rounding(e.variance, e.rounding_bound) {
                     bail!(
                         "N = {n}: the variance {:e} is at or below the {} form's rounding bound \
@@ -358,7 +404,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if a.json {
         // One count for a sampler's --sets; per level for files.
-        let points_sets = if a.points.is_empty() {
+        let points_sets = if method == MethodArg::Expected {
+            json!(0)
+        } else if a.points.is_empty() {
             json!(a.draw.sets())
         } else {
             json!(points.iter().map(|p| p.sets).collect::<Vec<_>>())
@@ -369,6 +417,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 (Subject::Square(_), _) => "square: unshifted estimator's MSE over the family (brute force)",
                 (_, MethodArg::Spatial) => "spatial",
                 (_, MethodArg::Fourier) => "fourier",
+                (_, MethodArg::Expected) => "expected: the sampler's closed-form expected spectrum",
             },
             "sets": points_sets,
             "points": points.iter().map(|p| json!({"n": p.n, "requested": p.requested, "variance": p.variance, "stderr": p.stderr, "truncation_bound": p.truncation_bound, "seed": p.seed})).collect::<Vec<_>>(),
@@ -383,7 +432,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     outln!("{:>8} {:>14} {:>12}", "N", "variance", "stderr");
     for p in &points {
-        let stderr = p.stderr.map_or("unknown".into(), |s| format!("{s:.2e}"));
+        let stderr = match p.stderr {
+            _ if method == MethodArg::Expected => "closed form".into(),
+            Some(s) => format!("{s:.2e}"),
+            None => "unknown".into(),
+        };
         outln!("{:>8} {:>14.6e} {stderr:>12}", p.n, p.variance);
     }
     let ci = fit
