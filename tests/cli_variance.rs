@@ -167,29 +167,33 @@ fn predict_judges_sheared_sets_by_the_estimator_they_were_built_for() {
 
 #[test]
 fn predict_output_does_not_depend_on_thread_count() {
-    let run = |threads: &str| {
-        let args = [
-            "predict",
-            "--sampler",
-            "cmj",
-            "-n",
-            "100",
-            "--integrand",
-            "box:w=0.3,h=0.6,angle=10",
-        ];
-        let args = [
-            &args[..],
-            &["--sets", "20", "--realizations", "3000", "--json"],
-        ]
-        .concat();
-        let out = varspec_with(&args, Some(threads));
-        let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        for k in ["expected", "fourier", "spatial", "empirical", "radial"] {
-            v[k].as_object_mut().unwrap().remove("seconds");
+    // A fixed --sets, and white noise's automatic count (a pilot of 16,
+    // then more: variance::sets).
+    for extra in [
+        &["--sampler", "cmj", "-n", "100", "--sets", "20"][..],
+        &["--sampler", "random", "-n", "256"][..],
+    ] {
+        let run = |threads: &str| {
+            let args = [
+                &["predict", "--integrand", "box:w=0.3,h=0.6,angle=10"][..],
+                extra,
+                &["--realizations", "3000", "--json"],
+            ]
+            .concat();
+            let out = varspec_with(&args, Some(threads));
+            let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            for k in ["expected", "fourier", "spatial", "empirical", "radial"] {
+                v[k].as_object_mut().unwrap().remove("seconds");
+            }
+            v
+        };
+        let one = run("1");
+        // White noise escalates here (72 sets), so both paths are compared.
+        if extra.contains(&"random") {
+            assert!(one["auto_sets"]["sets"].as_u64().unwrap() > 16, "{one}");
         }
-        v
-    };
-    assert_eq!(run("1"), run("2"));
+        assert_eq!(one, run("2"), "{extra:?}");
+    }
 }
 
 #[test]
