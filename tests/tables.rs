@@ -11,8 +11,11 @@ use varspec::io::tables::{
 };
 use varspec::rng::PREV_ONE;
 
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("varspec-tables-{}", std::process::id()));
+/// A folder of the test `tag`'s own: tests run side by side, and one that
+/// removes a shared folder pulls it from under another (a CI run lost
+/// `named/` to `every_format_round_trips`'s clean-up).
+fn dir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("varspec-tables-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
 }
@@ -36,7 +39,7 @@ fn sidecar(path: &Path) -> TableMetadata {
 
 #[test]
 fn every_format_round_trips() {
-    let d = dir();
+    let d = dir("round-trips");
     let reference = d.join("ref.csv");
     varspec(&[
         "sample",
@@ -456,7 +459,7 @@ fn a_sharded_table_run_merges_to_the_single_runs_bytes() {
 /// floats have no conventional extension) is refused naming the choices.
 #[test]
 fn the_format_follows_the_output_name() {
-    let d = dir().join("named");
+    let d = dir("named");
     std::fs::create_dir_all(&d).unwrap();
     for (ext, format) in [("csv", "csv"), ("json", "json"), ("h", "c-header")] {
         let (named, given) = (
