@@ -44,7 +44,7 @@ fn same_seed_gives_identical_bytes_on_one_and_two_threads() {
 
 #[test]
 fn output_file_matches_stdout_and_reads_back() {
-    let dir = temp_dir("out");
+    let dir = temp_dir("sample-out");
     let path = dir.join("j.csv");
     let file_run = varspec(&[
         "sample",

@@ -71,7 +71,7 @@ fn xu_projection_equals_the_spectrum_of_the_xu_columns() {
 
 #[test]
 fn outputs_are_written_in_every_format() {
-    let dir = temp_dir("out");
+    let dir = temp_dir("spectrum-out");
     let (csv, radial, png, rpng) = (
         dir.join("s.csv"),
         dir.join("r.csv"),
