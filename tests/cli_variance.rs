@@ -949,3 +949,63 @@ fn converge_with_closed_form_expectations() {
         "--method expected draws no sets",
     );
 }
+
+/// A truncation bound that rivals its value is named, not only printed:
+/// CMJ on an axis-aligned box integrates the edges at N^-2 through its
+/// N-rooks strata, energy far beyond the Fourier box, where the tail's
+/// white-noise estimate is 2–7× the true variance (a new-user trial read
+/// the "closed form" line as exact).
+#[test]
+fn loose_truncation_bounds_are_named() {
+    let out = common::varspec_ok(&[
+        "predict",
+        "--sampler",
+        "cmj",
+        "-n",
+        "1024",
+        "--integrand",
+        "box",
+        "--method",
+        "expected,spatial",
+    ]);
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        note.contains("note: expected: its truncation_bound is"),
+        "{note}"
+    );
+    let out = common::varspec_ok(&[
+        "converge",
+        "--sampler",
+        "cmj",
+        "--integrand",
+        "box",
+        "--method",
+        "expected",
+        "--n",
+        "256,1024",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("truncation_bound"), "{text}");
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        note.contains("truncation bound exceeds 10% of the value at N = 256"),
+        "{note}"
+    );
+    // Jitter on a disk: bounds far below the values, no note.
+    let out = common::varspec_ok(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "1024",
+        "--integrand",
+        "disk:r=0.3",
+        "--sets",
+        "16",
+    ]);
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -32,6 +32,9 @@ enum MethodArg {
     Expected,
 }
 
+/// A truncation bound above this fraction of its value is named.
+const LOOSE_BOUND: f64 = 0.1;
+
 #[derive(clap::Args)]
 #[command(group = clap::ArgGroup::new("levels").required(true).args(["sampler", "points"]))]
 #[command(group = clap::ArgGroup::new("subject").required(true).args(["integrand", "family"]))]
@@ -369,18 +372,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             ]
         };
         // Each level's 95% interval (normal, from its standard error over
-        // the sets or members); none where one set left it unknown.
+        // the sets or members; none where one set left it unknown),
+        // widened by the Fourier box's truncation bound (0 for the
+        // spatial form and the square).
         let z = varspec::variance::NORMAL_95;
         let bars = points
             .iter()
             .map(|p| {
-                p.stderr.map_or((p.variance, p.variance), |e| {
-                    (p.variance - z * e, p.variance + z * e)
-                })
+                let half = z * p.stderr.unwrap_or(0.0) + p.truncation_bound;
+                (p.variance - half, p.variance + half)
             })
             .collect();
+        let bars_are = match method {
+            _ if matches!(subject, Subject::Square(_)) => "95% CI",
+            MethodArg::Spatial => "95% CI",
+            MethodArg::Fourier => "95% CI + truncation bound",
+            MethodArg::Expected => "truncation bound",
+        };
         let mut series = vec![Series {
-            label: format!("{label} (slope {:.3}; bars: 95% CI)", fit.slope),
+            label: format!("{label} (slope {:.3}; bars: {bars_are})", fit.slope),
             points: ns.iter().copied().zip(vars.iter().copied()).collect(),
             reference: false,
             error_bars: bars,
@@ -430,14 +440,43 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if !adjusted.is_empty() {
         outln!("N adjusted to fit {label}: {}", adjusted.join(", "));
     }
-    outln!("{:>8} {:>14} {:>12}", "N", "variance", "stderr");
+    // The Fourier forms' truncation bound is part of a level's error:
+    // shown beside it, and named when it rivals the value.
+    let bounded = points.iter().any(|p| p.truncation_bound > 0.0);
+    let bound_header = if bounded { "  truncation_bound" } else { "" };
+    outln!(
+        "{:>8} {:>14} {:>12}{bound_header}",
+        "N",
+        "variance",
+        "stderr"
+    );
     for p in &points {
         let stderr = match p.stderr {
             _ if method == MethodArg::Expected => "closed form".into(),
             Some(s) => format!("{s:.2e}"),
             None => "unknown".into(),
         };
-        outln!("{:>8} {:>14.6e} {stderr:>12}", p.n, p.variance);
+        let bound = if bounded {
+            format!("  {:>16.2e}", p.truncation_bound)
+        } else {
+            String::new()
+        };
+        outln!("{:>8} {:>14.6e} {stderr:>12}{bound}", p.n, p.variance);
+    }
+    let loose: Vec<String> = points
+        .iter()
+        .filter(|p| p.truncation_bound > LOOSE_BOUND * p.variance)
+        .map(|p| format!("N = {} ({:.2}×)", p.n, p.truncation_bound / p.variance))
+        .collect();
+    if !loose.is_empty() {
+        eprintln!(
+            "note: the Fourier box's truncation bound exceeds {:.0}% of the value at {}: what \
+             lies beyond the box is not white there (an axis-aligned edge against N-rooks \
+             strata, a lattice's dual points, a spectrum still rising), so those values and the \
+             slope through them are uncertain by that much; raise --res, or use --method spatial",
+            100.0 * LOOSE_BOUND,
+            loose.join(", ")
+        );
     }
     let ci = fit
         .slope_ci
@@ -445,14 +484,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             format!("[{l:.3}, {h:.3}]")
         });
     let outside = fit.excludes(theory);
-    let theory = theory.map_or("none in the table".into(), |t| format!("{t}"));
+    let theory = theory.map_or(
+        "none (the table of known rates has no entry for this sampler and integrand)".into(),
+        |t| format!("{t}"),
+    );
     outln!("slope {:.3}, 95% CI {ci}; theory {theory}", fit.slope);
     if outside {
         outln!(
             "note: the theory's rate lies outside the interval. The table's rates are \
              asymptotic: over a finite range of N sub-leading terms can move a fit outside its \
              interval (Poisson disk measures -1.08 to -1.27 at N = 64…4096 against -1: \
-             results/rates)."
+             results/rates); and they are for edges in general position: an edge parallel to \
+             an axis meets N-rooks stratification (cmj, multijitter, nrooks, sobol), which \
+             integrates it faster (cmj on an axis-aligned box: -2)."
         );
     }
     super::stdout::wrote([&a.csv, &a.png].into_iter().flatten());

@@ -123,6 +123,15 @@ impl fmt::Display for LineProblem {
                 "CSV header must be `x0,x1,...` (or `x,y`, `x,y,z`, `x,y,u,v`, `x,y,z,w`), \
                  optionally after `set,`, found `{found}`"
             ),
+            // A CSV row splits at commas, so a comma inside a field means
+            // the file was read as UTK text: its first line began with `#`.
+            LineProblem::NotANumber { field, text } if text.contains(',') => write!(
+                f,
+                "field {field} is `{text}`, not a number: the file is read as UTK text \
+                 (whitespace-separated) because its first line starts with `#`; a CSV's header \
+                 is a plain `x0,x1` line (numpy's savetxt writes `# x0,x1` unless given \
+                 comments='')"
+            ),
             LineProblem::NotANumber { field, text } => {
                 write!(f, "field {field} is `{text}`, not a number")
             }

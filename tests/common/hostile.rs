@@ -109,7 +109,7 @@ pub fn write_fixtures(dir: &Path) {
     // A 4 × 4 grey PFM (little-endian), a reference of the wrong size.
     let mut pfm = b"Pf\n4 4\n-1.0\n".to_vec();
     pfm.extend((0..16).flat_map(|i| (i as f32 / 16.0).to_le_bytes()));
-    let files: [(&str, Vec<u8>); 14] = [
+    let files: [(&str, Vec<u8>); 15] = [
         (
             "three.csv",
             "set,x0,x1\n0,0.1,0.2\n0,0.6,0.7\n1,0.3,0.4\n1,0.8,0.9\n2,0.5,0.1\n2,0.0,0.6\n".into(),
@@ -121,6 +121,7 @@ pub fn write_fixtures(dir: &Path) {
         ("long-line.csv", vec![b'0'; (1 << 20) + 10]),
         ("bom.csv", "\u{feff}x0,x1\n0.1,0.2\n".into()),
         ("bom-bad-header.csv", "\u{feff}a,b\n0.1,0.2\n".into()),
+        ("numpy-hash.csv", "# x0,x1\n0.1,0.2\n0.3,0.4\n".into()),
         ("huge-weights.csv", "k,weight\n1,1e308\n2,1e308\n".into()),
         ("bom-weights.csv", "\u{feff}k,weight\n1,1\n2,0.5\n".into()),
         ("garbage.bin", "garbage\n".into()),
