@@ -281,7 +281,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if let Some(path) = &a.shear_png {
         let values: Vec<f64> = shears.iter().map(SampleShear::slope).collect();
-        let lim = values.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-9);
+        // Symmetric about 0; ±1 when every pixel is unsheared (a bar from
+        // −1e-9 to 1e-9 read "0" at every tick).
+        let lim = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let lim = if lim > 0.0 { lim } else { 1.0 };
         heatmap_png(
             &HeatMap {
                 title: format!("light-field slope the shear follows, {title}"),

@@ -446,7 +446,7 @@ pub fn heatmap_png(map: &HeatMap, path: &Path) -> Result<(), Error> {
         ))));
     }
     ensure_font();
-    let (lo, hi) = map.colour_range;
+    let (lo, hi) = colour_span(map.colour_range);
     let (w, h) = (760u32, 640u32);
     let mut buf = vec![255u8; (w * h * 3) as usize];
     let (heat, bar) = draw_heatmap_frame(map, &mut buf, (w, h)).map_err(fail)?;
@@ -485,6 +485,31 @@ pub fn heatmap_png(map: &HeatMap, path: &Path) -> Result<(), Error> {
 
 type PixelRange = (std::ops::Range<i32>, std::ops::Range<i32>);
 
+/// A colour range that spans something: a constant field (every pixel's
+/// shear 0) gets v ± 1 instead of a bar whose ticks all read the same.
+fn colour_span((lo, hi): (f64, f64)) -> (f64, f64) {
+    if hi > lo {
+        (lo, hi)
+    } else if lo.is_finite() {
+        (lo - 1.0, lo + 1.0)
+    } else {
+        (-1.0, 1.0)
+    }
+}
+
+/// A tick label: whole numbers without a decimal point, others to the
+/// fourth significant digit, and no "-0".
+fn tick_number(v: f64) -> String {
+    let v = if v == 0.0 { 0.0 } else { v };
+    if v.fract() == 0.0 && v.abs() < 1e9 {
+        format!("{v:.0}")
+    } else {
+        let text = format!("{:.4}", v);
+        let text = text.trim_end_matches('0').trim_end_matches('.').to_string();
+        if text == "-0" { "0".into() } else { text }
+    }
+}
+
 /// Draws axes, labels and colour-bar ticks; returns the pixel ranges of the
 /// heat map and the colour bar, which the caller fills.
 fn draw_heatmap_frame(
@@ -503,18 +528,20 @@ fn draw_heatmap_frame(
     let mut heat = ChartBuilder::on(&left)
         .margin(12)
         .x_label_area_size(44)
-        .y_label_area_size(56)
+        .y_label_area_size(72)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(draw_error)?;
     heat.configure_mesh()
         .disable_mesh()
+        .x_label_formatter(&|v| tick_number(*v))
+        .y_label_formatter(&|v| tick_number(*v))
         .x_desc(map.x_label.as_str())
         .y_desc(map.y_label.as_str())
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 17))
         .draw()
         .map_err(draw_error)?;
-    let (lo, hi) = map.colour_range;
+    let (lo, hi) = colour_span(map.colour_range);
     let mut bar = ChartBuilder::on(&right)
         .margin_top(12)
         .margin_bottom(56)
@@ -525,6 +552,7 @@ fn draw_heatmap_frame(
     bar.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
+        .y_label_formatter(&|v| tick_number(*v))
         .y_desc(map.bar_label.as_str())
         .label_style(("sans-serif", 15))
         .axis_desc_style(("sans-serif", 15))
@@ -541,6 +569,17 @@ fn draw_heatmap_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tick_labels_are_tidy() {
+        assert_eq!(tick_number(250.0), "250");
+        assert_eq!(tick_number(-0.0), "0");
+        assert_eq!(tick_number(-0.00001), "0");
+        assert_eq!(tick_number(-2.5), "-2.5");
+        assert_eq!(tick_number(0.125), "0.125");
+        assert_eq!(colour_span((0.0, 0.0)), (-1.0, 1.0));
+        assert_eq!(colour_span((-3.0, -2.0)), (-3.0, -2.0));
+    }
 
     #[test]
     fn log_ticks_are_distinct_and_exact() {
