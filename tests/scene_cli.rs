@@ -273,6 +273,54 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
         &["render", "dof", "--variance-png", "v.png"],
         "--renders 2 or more",
     );
+    assert_fails(
+        &[
+            "render",
+            "dof",
+            "--renders",
+            "2",
+            "--variance-png",
+            "v.png",
+            "--variance-range",
+            "-2,-6",
+        ],
+        "two finite numbers with LO < HI",
+    );
+    // A range far below every pixel's variance paints every non-zero pixel
+    // the top colour (viridis yellow): the range is the one given.
+    let png = dir.join("ranged.png");
+    let out = common::varspec(&[
+        "render",
+        "dof",
+        "--spp",
+        "4",
+        "--renders",
+        "2",
+        "-o",
+        dir.join("ranged-img.png").to_str().unwrap(),
+        "--variance-png",
+        png.to_str().unwrap(),
+        "--variance-range",
+        "-30,-29",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let img = image::open(&png).unwrap().to_rgb8();
+    let (mut yellow, mut other) = (0, 0);
+    // The heat map's middle (inside its axes), away from the colour bar.
+    for y in 200..400 {
+        for x in 150..450 {
+            match img.get_pixel(x, y).0 {
+                [r, g, b] if r > 240 && g > 215 && b < 60 => yellow += 1,
+                [128, 128, 128] => {}
+                _ => other += 1,
+            }
+        }
+    }
+    assert!(yellow > 20 * other.max(1), "yellow {yellow}, other {other}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

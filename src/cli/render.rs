@@ -64,6 +64,11 @@ pub struct Args {
     /// Heat map PNG of log10 per-pixel variance, with a colour bar.
     #[arg(long)]
     variance_png: Option<PathBuf>,
+    /// Colour range of --variance-png as log10 variance LO,HI, e.g. -6,-2
+    /// (default: the image's own): give two renders the same to compare
+    /// their maps.
+    #[arg(long, value_name = "LO,HI", value_parser = log_range, requires = "variance_png", allow_hyphen_values = true)]
+    variance_range: Option<(f64, f64)>,
     /// Float image (PFM) of the per-pixel variance.
     #[arg(long)]
     variance_pfm: Option<PathBuf>,
@@ -243,7 +248,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         if let Some(path) = &a.variance_png {
             var.write_variance_png(
                 &format!("variance over {} renders, {title}", a.renders),
-                None,
+                a.variance_range,
                 path,
             )?;
         }
@@ -382,4 +387,16 @@ fn summary_json(
         out["mse_against_reference"] = serde_json::json!(mse);
     }
     out
+}
+
+/// `LO,HI`: two finite numbers with LO < HI (a log10 colour range).
+fn log_range(text: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let numbers: Vec<f64> = parts.iter().filter_map(|p| p.parse().ok()).collect();
+    match numbers[..] {
+        [lo, hi] if parts.len() == 2 && lo.is_finite() && hi.is_finite() && lo < hi => Ok((lo, hi)),
+        _ => Err(format!(
+            "expected LO,HI: two finite numbers with LO < HI (log10 variance, e.g. -6,-2), got `{text}`"
+        )),
+    }
 }
