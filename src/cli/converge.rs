@@ -32,9 +32,6 @@ enum MethodArg {
     Expected,
 }
 
-/// A truncation bound above this fraction of its value is named.
-const LOOSE_BOUND: f64 = 0.1;
-
 #[derive(clap::Args)]
 #[command(group = clap::ArgGroup::new("levels").required(true).args(["sampler", "points"]))]
 #[command(group = clap::ArgGroup::new("subject").required(true).args(["integrand", "family"]))]
@@ -465,17 +462,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let loose: Vec<String> = points
         .iter()
-        .filter(|p| p.truncation_bound > LOOSE_BOUND * p.variance)
+        .filter(|p| p.truncation_bound > super::args::LOOSE_TRUNCATION * p.variance)
         .map(|p| format!("N = {} ({:.2}×)", p.n, p.truncation_bound / p.variance))
         .collect();
     if !loose.is_empty() {
         eprintln!(
-            "note: the Fourier box's truncation bound exceeds {:.0}% of the value at {}: what \
-             lies beyond the box is not white there (an axis-aligned edge against N-rooks \
-             strata, a lattice's dual points, a spectrum still rising), so those values and the \
-             slope through them are uncertain by that much; raise --res, or use --method spatial",
-            100.0 * LOOSE_BOUND,
-            loose.join(", ")
+            "note: the Fourier box's truncation bound exceeds {:.0}% of the value at {}: {}, \
+             so those values and the slope through them are uncertain by that much; raise \
+             --res, or use --method spatial",
+            100.0 * super::args::LOOSE_TRUNCATION,
+            loose.join(", "),
+            super::args::NOT_WHITE_BEYOND_THE_BOX
         );
     }
     let ci = fit

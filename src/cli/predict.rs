@@ -7,6 +7,7 @@ use anyhow::{anyhow, bail};
 use clap::ValueEnum;
 use serde_json::{Value, json};
 
+use super::args;
 use super::progress;
 use super::source::{SourceArgs, realization_error};
 use varspec::PointSet;
@@ -451,8 +452,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// A truncation bound above this fraction of its value is named.
-const LOOSE_BOUND: f64 = 0.1;
 /// An anisotropy bound above this fraction of its value is named: it is a
 /// Cauchy–Schwarz bound, several times the radial form's actual error on
 /// nearly isotropic spectra (jitter on a disk: bound 14% of the value,
@@ -464,22 +463,22 @@ const LOOSE_ANISOTROPY: f64 = 0.5;
 /// does not whiten) and the radial form's anisotropy bound. The values are
 /// printed either way; the note says they are uncertain by that much.
 fn note_loose_bounds(out: &serde_json::Map<String, Value>) {
+    let truncation = format!(
+        "{}: raise --res, or trust spatial",
+        args::NOT_WHITE_BEYOND_THE_BOX
+    );
     for (key, bound, loose, why) in [
         (
             "expected",
             "truncation_bound",
-            LOOSE_BOUND,
-            "beyond the Fourier box the spectrum is not white (an axis-aligned edge against \
-             N-rooks strata, a lattice's dual points, a spectrum still rising): raise --res, or \
-             trust spatial",
+            args::LOOSE_TRUNCATION,
+            truncation.as_str(),
         ),
         (
             "fourier",
             "truncation_bound",
-            LOOSE_BOUND,
-            "beyond the Fourier box the spectrum is not white (an axis-aligned edge against \
-             N-rooks strata, a lattice's dual points, a spectrum still rising): raise --res, or \
-             trust spatial",
+            args::LOOSE_TRUNCATION,
+            truncation.as_str(),
         ),
         (
             "radial",
