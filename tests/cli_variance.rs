@@ -871,6 +871,22 @@ fn predict_runs_the_listed_methods() {
     ] {
         assert_eq!(v.get(key).is_some(), present, "{key}: {v}");
     }
+    // A 4D padded set has a closed form through its halves; `all` adds it.
+    let v = json(&[
+        "predict",
+        "--sampler",
+        "umj",
+        "-n",
+        "64",
+        "--integrand",
+        "defocus:shape=disk,size=0.3,c=0.5",
+        "--method",
+        "all",
+        "--realizations",
+        "200",
+        "--json",
+    ]);
+    assert!(v["expected"]["variance"].as_f64().unwrap() > 0.0, "{v}");
     common::assert_fails(
         &[
             "predict",

@@ -15,6 +15,7 @@ use varspec::io::write_atomic;
 use varspec::registry;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
 use varspec::source::Source;
+use varspec::spectrum::ClosedFormSpectrum;
 use varspec::square::{Family, family_mse};
 use varspec::variance::{
     SamplerVariance, VarianceForm, fit_slope, fourier_expected, sampler_variance, theoretical_rate,
@@ -161,10 +162,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.res.is_some() && method == MethodArg::Spatial {
         bail!("--res sets the Fourier form's box: it applies to --method fourier or expected");
     }
-    if method == MethodArg::Expected && (a.sampler.is_none() || dim != 2) {
+    if method == MethodArg::Expected && a.sampler.is_none() {
         bail!(
             "--method expected takes a sampler's closed-form expected spectrum: it needs \
-             --sampler (not --points) and a 2D integrand"
+             --sampler (not --points)"
         );
     }
     if method == MethodArg::Expected && a.draw.sets_were_given() {
@@ -245,13 +246,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 });
                 let e = match (method, &source) {
                     (MethodArg::Expected, Source::Sampler { sampler, .. }) => {
-                        let pairs = sampler.pair_spectrum().with_context(|| {
-                            format!(
-                                "--method expected: {label} has no closed-form expected \
-                                 spectrum (2D random, jitter, regular, uniform-jitter, \
-                                 multijitter and cmj have one); use --method spatial"
-                            )
-                        })?;
+                        let closed = ClosedFormSpectrum::of(sampler.as_ref())
+                            .filter(|c| c.dim() == dim)
+                            .with_context(|| {
+                                format!(
+                                    "--method expected: {label} has no closed-form expected \
+                                     spectrum in {dim}D (2D random, jitter, regular, \
+                                     uniform-jitter, multijitter and cmj have one, 4D umj and \
+                                     padded sets of those); use --method spatial or fourier"
+                                )
+                            })?;
                         // Without --res the box grows with N, half-width
                         // 4√N (at least the default's): a stratified set's
                         // spectrum rises to white noise near k ≈ √N, and a
@@ -259,10 +263,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         // (cmj at N = 65,536 on a 255² box: truncation bound
                         // 2× the value; 2049²: 5%, 3 s).
                         let half = match a.res {
-                            Some(_) => half,
-                            None => half.max((4.0 * (n as f64).sqrt()).ceil() as usize),
+                            None if dim == 2 => half.max((4.0 * (n as f64).sqrt()).ceil() as usize),
+                            _ => half,
                         };
-                        let p = fourier_expected(f.as_ref(), half, pairs)?.estimate;
+                        let p = fourier_expected(f.as_ref(), half, &closed)?.estimate;
                         SamplerVariance {
                             variance: p.variance,
                             stderr: 0.0,

@@ -14,6 +14,7 @@ use varspec::PointSet;
 use varspec::integrands::{self, Integrand};
 use varspec::scene::pixel::PixelIntegrand;
 use varspec::source::Source;
+use varspec::spectrum::ClosedFormSpectrum;
 use varspec::variance::{
     DEFAULT_SHIFT_SEED, TARGET_RELATIVE_STDERR, VarianceError, auto_set_cap, empirical_shifting,
     fourier_expected, fourier_parts, radial_from, sets_for_relative_stderr, spatial,
@@ -238,25 +239,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     let n = source.points_per_set();
-    // The closed-form expected spectrum of a 2D sampler, drawn whole.
-    let pairs = match &source {
+    // The closed-form expected spectrum of the sampler, if it has one.
+    let closed = match &source {
         Source::Sampler {
             sampler,
             dims: None,
             ..
-        } if f.dim() == 2 && f.has_fourier() => sampler.pair_spectrum(),
+        } if f.has_fourier() => {
+            ClosedFormSpectrum::of(sampler.as_ref()).filter(|c| c.dim() == f.dim())
+        }
         _ => None,
     };
-    if asks(MethodArg::Expected) && pairs.is_none() {
+    if asks(MethodArg::Expected) && closed.is_none() {
         bail!(
             "--method expected needs a sampler with a closed-form expected spectrum (2D random, \
-             jitter, regular, uniform-jitter, multijitter, cmj; not a file or a projection) and \
-             an integrand with Fourier coefficients; {} on {} has none: use --method fourier",
+             jitter, regular, uniform-jitter, multijitter, cmj; 4D umj and padded sets of \
+             those; not a file or a projection) and an integrand with Fourier coefficients; {} \
+             on {} has none: use --method fourier",
             source.name(),
             f.spec()
         );
     }
-    let closed_form = pairs.is_some();
+    let closed_form = closed.is_some();
     let wants = |m: MethodArg| {
         asks(m)
             || (asks(MethodArg::All)
@@ -282,15 +286,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     out.insert("estimator".into(), json!(shift.estimator()));
-    if let Some(pairs) = pairs.filter(|_| wants(MethodArg::Expected)) {
-        // Without --res the closed form's box grows with N (half-width
+    if let Some(closed) = closed.filter(|_| wants(MethodArg::Expected)) {
+        // Without --res the closed form's 2D box grows with N (half-width
         // 4√N, as converge's): it costs no sets, and a stratified set's
-        // spectrum rises to white noise near k ≈ √N.
-        let res = a
-            .res
-            .unwrap_or_else(|| 256.max(2 * (4.0 * (n as f64).sqrt()).ceil() as usize + 1));
+        // spectrum rises to white noise near k ≈ √N. In 4D, the Fourier
+        // form's box.
+        let res = a.res.unwrap_or_else(|| match f.dim() {
+            2 => 256.max(2 * (4.0 * (n as f64).sqrt()).ceil() as usize + 1),
+            _ => 16,
+        });
         let start = Instant::now();
-        let e = fourier_expected(f.as_ref(), res.saturating_sub(1) / 2, pairs)?.estimate;
+        let e = fourier_expected(f.as_ref(), res.saturating_sub(1) / 2, &closed)?.estimate;
         out.insert(
             "expected".into(),
             json!({

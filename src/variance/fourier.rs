@@ -56,8 +56,7 @@ use rayon::prelude::*;
 use super::VarianceError;
 use crate::integrands::Integrand;
 use crate::points::PointSet;
-use crate::spectrum::pair::PairSpectrum;
-use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power_with};
+use crate::spectrum::{ClosedFormSpectrum, FrequencyBox, Method, Spectrum, expected_power_with};
 use crate::sum::NeumaierSum;
 
 /// Shell deviation |N·P_S − 1| above which the spectrum is treated as a
@@ -228,46 +227,48 @@ where
 }
 
 /// The Fourier form with the sampler's closed-form expected power
-/// E[N·P_S(k)] = 1 + C(k, k)/N ([`PairSpectrum`]: random, jitter,
-/// multi-jitter and CMJ in 2D) in place of realizations: the expectation
-/// Σ_(k≠0) E[P_S(k)]·P_f(k) of Pilleboue et al. 2015, Eq. (9), itself, with
-/// no sampling error (`stderr` 0, `sets` 0), and the same Parseval tail,
-/// whose bound now reads an exact shell.
+/// E[N·P_S(k)] ([`ClosedFormSpectrum`]: random, jitter, multi-jitter and
+/// CMJ in 2D through their pair sums, 1 + C(k, k)/N; padded 4D samplers
+/// such as umj whose halves have them) in place of realizations: the
+/// expectation Σ_(k≠0) E[P_S(k)]·P_f(k) of Pilleboue et al. 2015, Eq. (9),
+/// itself, with no sampling error (`stderr` 0, `sets` 0), and the same
+/// Parseval tail, whose bound now reads an exact shell.
 ///
 /// # Errors
 /// [`VarianceError::NoFourier`] for an integrand without Fourier
-/// coefficients, [`VarianceError::Dimension`] for one that is not 2D, and
-/// a box too large for memory.
+/// coefficients, [`VarianceError::Dimension`] for one of another dimension
+/// than the points, and a box too large for memory.
 pub fn fourier_expected(
     f: &dyn Integrand,
     half: usize,
-    pairs: &dyn PairSpectrum,
+    closed: &ClosedFormSpectrum,
 ) -> Result<FourierParts, VarianceError> {
     if !f.has_fourier() {
         return Err(VarianceError::NoFourier { spec: f.spec() });
     }
-    if f.dim() != 2 {
+    let dim = closed.dim();
+    if f.dim() != dim {
         return Err(VarianceError::Dimension {
             integrand: f.dim(),
-            points: 2,
+            points: dim,
         });
     }
-    let n = pairs.points();
+    let n = closed.points();
     if n == 0 {
         return Err(VarianceError::NoPoints {
             what: "the Fourier predictor",
         });
     }
-    let freqs = FrequencyBox { dim: 2, half };
+    let freqs = FrequencyBox { dim, half };
     crate::spectrum::nufft::check_nufft_memory(&freqs)?;
     let pf = integrand_power(f, &freqs);
     let power: Vec<f64> = (0..freqs.len())
         .into_par_iter()
         .map_init(
-            || vec![0i64; 2],
+            || vec![0i64; dim],
             |k, idx| {
                 freqs.frequency(idx, k);
-                pairs.power([k[0] as f64, k[1] as f64])
+                closed.power(k)
             },
         )
         .collect();
