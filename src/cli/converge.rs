@@ -28,8 +28,9 @@ enum MethodArg {
     /// Fourier form with the Parseval tail.
     Fourier,
     /// The Fourier form with the sampler's closed-form expected spectrum
-    /// (2D random, jitter, regular, uniform-jitter, multijitter, cmj): the
-    /// expected variance itself at each N, no sets and no sampling noise.
+    /// (2D random, jitter, regular, uniform-jitter, multijitter, cmj; 4D umj
+    /// and padded sets of those): the expected variance itself at each N,
+    /// no sets and no sampling noise.
     Expected,
 }
 
@@ -66,7 +67,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     method: Option<MethodArg>,
     /// Fourier box |k| < K/2 for --method fourier or expected (default 256 in
-    /// 2D, 21 in 4D; for expected, at least 8√N + 1 at each N).
+    /// 2D, 21 in 4D; for expected in 2D, at least 8√N + 1 at each N).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// CSV of N against variance.

@@ -24,8 +24,9 @@ use varspec::variance::{
 enum MethodArg {
     Fourier,
     /// The Fourier form with the sampler's closed-form expected spectrum
-    /// (2D random, jitter, regular, uniform-jitter, multijitter, cmj): no
-    /// realizations, no sampling error; part of `all` where it exists.
+    /// (2D random, jitter, regular, uniform-jitter, multijitter, cmj; 4D
+    /// umj and padded sets of those): no realizations, no sampling error;
+    /// part of `all` where it exists.
     Expected,
     Spatial,
     Empirical,
