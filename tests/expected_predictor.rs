@@ -8,7 +8,7 @@
 use varspec::integrands;
 use varspec::registry;
 use varspec::rng::set_rng;
-use varspec::spectrum::ClosedFormSpectrum;
+use varspec::samplers::ClosedFormSpectrum;
 use varspec::variance::{VarianceError, fourier, fourier_expected, spatial};
 
 /// Two-sided normal quantile of 99.9%.

@@ -14,8 +14,8 @@ use varspec::integrands;
 use varspec::io::write_atomic;
 use varspec::registry;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
+use varspec::samplers::ClosedFormSpectrum;
 use varspec::source::Source;
-use varspec::spectrum::ClosedFormSpectrum;
 use varspec::square::{Family, family_mse};
 use varspec::variance::{
     SamplerVariance, VarianceForm, fit_slope, fourier_expected, sampler_variance, theoretical_rate,

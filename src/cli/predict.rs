@@ -12,9 +12,9 @@ use super::progress;
 use super::source::{SourceArgs, realization_error};
 use varspec::PointSet;
 use varspec::integrands::{self, Integrand};
+use varspec::samplers::ClosedFormSpectrum;
 use varspec::scene::pixel::PixelIntegrand;
 use varspec::source::Source;
-use varspec::spectrum::ClosedFormSpectrum;
 use varspec::variance::{
     DEFAULT_SHIFT_SEED, TARGET_RELATIVE_STDERR, VarianceError, auto_set_cap, empirical_shifting,
     fourier_expected, fourier_parts, radial_from, sets_for_relative_stderr, spatial,

@@ -7,6 +7,7 @@
 //! realizations in parallel, realization r from stream (seed, r), so the
 //! output is identical for any number of threads.
 
+pub mod closed_form;
 pub mod config;
 pub(crate) mod halton;
 pub(crate) mod isotropic_jitter;
@@ -19,6 +20,7 @@ pub(crate) mod random;
 pub(crate) mod sobol;
 mod sobol_table;
 
+pub use closed_form::ClosedFormSpectrum;
 pub use halton::Halton;
 pub use isotropic_jitter::IsotropicJitter;
 pub use jitter::{Jitter, StratumOffset};

@@ -3,7 +3,6 @@
 //! power E[N·P_S(k)] over realizations ([`expected`]); radial averages and
 //! anisotropy ([`radial`]); the pair correlation function ([`pcf`]).
 
-pub mod closed_form;
 pub mod dft;
 pub mod expected;
 pub mod frequencies;
@@ -13,7 +12,6 @@ pub mod pcf;
 pub mod phase;
 pub mod radial;
 
-pub use closed_form::ClosedFormSpectrum;
 pub use expected::{Method, Spectrum, expected_power, expected_power_with};
 pub use frequencies::FrequencyBox;
 pub use nufft::{NufftPlan, Sign, Upsampling};

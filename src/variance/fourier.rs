@@ -56,7 +56,8 @@ use rayon::prelude::*;
 use super::VarianceError;
 use crate::integrands::Integrand;
 use crate::points::PointSet;
-use crate::spectrum::{ClosedFormSpectrum, FrequencyBox, Method, Spectrum, expected_power_with};
+use crate::samplers::ClosedFormSpectrum;
+use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power_with};
 use crate::sum::NeumaierSum;
 
 /// Shell deviation |N·P_S − 1| above which the spectrum is treated as a

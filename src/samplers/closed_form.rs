@@ -14,8 +14,8 @@
 //!
 //! which at k_uv = 0 (C_uv = N(N − 1)) is the (x, y) half's own power.
 
-use super::pair::PairSpectrum;
-use crate::samplers::Sampler;
+use super::Sampler;
+use crate::spectrum::pair::PairSpectrum;
 
 /// The closed-form expected power of a sampler.
 #[derive(Clone, Copy)]
