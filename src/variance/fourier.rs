@@ -285,7 +285,6 @@ pub fn fourier_expected(
 /// Parseval tail and its bound, the rounding bound, and the standard error
 /// from the per-set in-box sums `per_set` (none for a closed form: 0).
 /// `counts` holds every set's N (one entry, N, for a closed form).
-#[allow(clippy::too_many_arguments)]
 fn assemble(
     f: &dyn Integrand,
     tolerance: f64,
