@@ -257,15 +257,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                                      padded sets of those); use --method spatial or fourier"
                                 )
                             })?;
-                        // Without --res the box grows with N, half-width
-                        // 4√N (at least the default's): a stratified set's
-                        // spectrum rises to white noise near k ≈ √N, and a
-                        // fixed box leaves that rise to the tail estimate
-                        // (cmj at N = 65,536 on a 255² box: truncation bound
-                        // 2× the value; 2049²: 5%, 3 s).
+                        // Without --res the box grows with N where that
+                        // matters (variance::expected_min_half).
                         let half = match a.res {
-                            None if dim == 2 => half.max((4.0 * (n as f64).sqrt()).ceil() as usize),
-                            _ => half,
+                            None => half.max(varspec::variance::expected_min_half(dim, n)),
+                            Some(_) => half,
                         };
                         let p = fourier_expected(f.as_ref(), half, &closed)?.estimate;
                         SamplerVariance {

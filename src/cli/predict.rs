@@ -17,7 +17,8 @@ use varspec::scene::pixel::PixelIntegrand;
 use varspec::source::Source;
 use varspec::variance::{
     DEFAULT_SHIFT_SEED, TARGET_RELATIVE_STDERR, VarianceError, auto_set_cap, empirical_shifting,
-    fourier_expected, fourier_parts, radial_from, sets_for_relative_stderr, spatial,
+    expected_min_half, fourier_expected, fourier_parts, radial_from, sets_for_relative_stderr,
+    spatial,
 };
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -288,13 +289,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     out.insert("estimator".into(), json!(shift.estimator()));
     if let Some(closed) = closed.filter(|_| wants(MethodArg::Expected)) {
-        // Without --res the closed form's 2D box grows with N (half-width
-        // 4√N, as converge's): it costs no sets, and a stratified set's
-        // spectrum rises to white noise near k ≈ √N. In 4D, the Fourier
-        // form's box.
-        let res = a.res.unwrap_or_else(|| match f.dim() {
-            2 => 256.max(2 * (4.0 * (n as f64).sqrt()).ceil() as usize + 1),
-            _ => 16,
+        // Without --res the closed form's box is the Fourier form's, grown
+        // with N where that matters (variance::expected_min_half).
+        let res = a.res.unwrap_or_else(|| {
+            let fourier = if f.dim() == 2 { 256 } else { 16 };
+            fourier.max(2 * expected_min_half(f.dim(), n) + 1)
         });
         let start = Instant::now();
         let e = fourier_expected(f.as_ref(), res.saturating_sub(1) / 2, &closed)?.estimate;

@@ -59,6 +59,20 @@ pub fn fourier_half(dim: usize) -> usize {
     }
 }
 
+/// The smallest box half-width a closed-form expected spectrum
+/// ([`super::fourier_expected`]) is evaluated on for N points by default:
+/// ⌈4√N⌉ in 2D, where a stratified set's spectrum rises to white noise near
+/// k ≈ √N and a fixed box would leave that rise to the tail estimate (CMJ at
+/// N = 65,536 on a 255² box: truncation bound 2× the value; on 2049²: 5%);
+/// 0 (no minimum) in other dimensions, where the box grows as K^d.
+pub fn expected_min_half(dim: usize, n: usize) -> usize {
+    if dim == 2 {
+        (4.0 * (n as f64).sqrt()).ceil() as usize
+    } else {
+        0
+    }
+}
+
 /// The variance of the shift-randomized estimator averaged over `sets`
 /// realizations, by the form `form` says (`converge --method`; `Auto` for
 /// `experiment`).

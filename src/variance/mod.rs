@@ -24,7 +24,8 @@ pub use empirical::{
 };
 pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_expected, fourier_parts};
 pub use measure::{
-    SamplerVariance, VarianceForm, fourier_half, sampler_variance, zero_to_rounding,
+    SamplerVariance, VarianceForm, expected_min_half, fourier_half, sampler_variance,
+    zero_to_rounding,
 };
 pub use paired::{VarianceRatio, paired_ratio};
 pub use radial::{RadialEstimate, radial_from};
