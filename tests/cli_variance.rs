@@ -973,6 +973,9 @@ fn converge_with_closed_form_expectations() {
 /// the "closed form" line as exact).
 #[test]
 fn loose_truncation_bounds_are_named() {
+    // The sets' spectrum on the box, white beyond it, against N-rooks
+    // strata on an axis-aligned edge (the closed form sums those axes: it
+    // is tight there, tests/expected_predictor.rs).
     let out = common::varspec_ok(&[
         "predict",
         "--sampler",
@@ -982,7 +985,24 @@ fn loose_truncation_bounds_are_named() {
         "--integrand",
         "box",
         "--method",
-        "expected,spatial",
+        "fourier,spatial",
+    ]);
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        note.contains("note: fourier: its truncation_bound is"),
+        "{note}"
+    );
+    // A lattice's closed form: its dual points beyond the box.
+    let out = common::varspec_ok(&[
+        "predict",
+        "--sampler",
+        "regular",
+        "-n",
+        "1024",
+        "--integrand",
+        "box:w=0.4,h=0.2,angle=30",
+        "--method",
+        "expected",
     ]);
     let note = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -996,7 +1016,7 @@ fn loose_truncation_bounds_are_named() {
         "--integrand",
         "box",
         "--method",
-        "expected",
+        "fourier",
         "--n",
         "256,1024",
     ]);

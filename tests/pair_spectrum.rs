@@ -96,3 +96,33 @@ fn jitter_power_is_pilleboue_s_formula() {
         }
     }
 }
+
+#[test]
+fn power_grid_is_the_power_at_each_frequency() {
+    // Multi-jitter and CMJ share each axis's factors across the grid;
+    // jitter takes the default, frequency by frequency. Real and integer
+    // frequencies, both signs, square and oblong grids.
+    let xs = [-37.0, -2.5, 0.0, 1.0, 6.0, 129.0, 1000.25];
+    let ys = [-5.0, -0.75, 0.0, 3.0, 64.0];
+    for (name, n) in [
+        ("multijitter", 64),
+        ("cmj", 64),
+        ("cmj", 24),
+        ("jitter", 49),
+    ] {
+        let sampler = registry::build(name, n, Some(2), &[]).unwrap();
+        let pairs = sampler.pair_spectrum().unwrap();
+        let grid = pairs.power_grid(&xs, &ys);
+        assert_eq!(grid.len(), xs.len() * ys.len());
+        for (i, &x) in xs.iter().enumerate() {
+            for (j, &y) in ys.iter().enumerate() {
+                let one = pairs.power([x, y]);
+                assert!(
+                    (grid[i * ys.len() + j] - one).abs() <= 1e-12 * one.abs().max(1.0),
+                    "{name} N={n} at ({x}, {y}): grid {} vs power {one}",
+                    grid[i * ys.len() + j]
+                );
+            }
+        }
+    }
+}

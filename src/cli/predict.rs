@@ -302,6 +302,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             json!({
                 "variance": e.variance, "truncation_bound": e.truncation_bound,
                 "rounding_bound": e.rounding_bound, "in_box": e.in_box, "tail": e.tail,
+                "axis_strips": e.strips.map(|s| json!({
+                    "half_width": s.width, "reach": s.reach,
+                    "correction": s.correction / n as f64,
+                })),
                 "res": res, "seconds": start.elapsed().as_secs_f64(),
             }),
         );

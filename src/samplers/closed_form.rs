@@ -60,6 +60,15 @@ impl<'a> ClosedFormSpectrum<'a> {
         }
     }
 
+    /// E[N·P_S] of a 2D closed form at every (x, y) of `xs` × `ys`,
+    /// row-major by x ([`PairSpectrum::power_grid`]); `None` in 4D.
+    pub fn power_grid(&self, xs: &[f64], ys: &[f64]) -> Option<Vec<f64>> {
+        match self {
+            ClosedFormSpectrum::Planar(p) => Some(p.power_grid(xs, ys)),
+            ClosedFormSpectrum::Padded { .. } => None,
+        }
+    }
+
     /// E[N·P_S(k)] at the integer frequency `k` (of [`Self::dim`] entries).
     pub fn power(&self, k: &[i64]) -> f64 {
         let w = |i: usize| [k[i] as f64, k[i + 1] as f64];

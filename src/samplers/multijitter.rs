@@ -172,28 +172,45 @@ impl Sampler for MultiJitter {
 /// R_x the mean of e^(2πi(ω_x t − ω′_x t′)/N) over distinct t, t′ < n,
 /// U_x = (1/n) Σ_(t<n) e^(2πi(ω_x−ω′_x)t/N), c_x = χ(ω_x/N)conj(χ(ω′_x/N)),
 /// and the y terms likewise with the roles of m and n exchanged.
-impl PairSpectrum for MultiJitter {
-    fn points(&self) -> usize {
-        self.points_per_set()
+/// One axis's factors of C(ω, ω′) (the names of the doc above):
+/// (Q, D, c, R, U, χ(ω/cells)·conj(χ(ω′/cells))).
+type AxisFactors = (
+    Complex64,
+    Complex64,
+    Complex64,
+    Complex64,
+    Complex64,
+    Complex64,
+);
+
+impl MultiJitter {
+    /// The x factors (`cells` = m columns, `fine` = n) or the y factors
+    /// (n rows, m) at the frequencies (a, b).
+    fn axis_factors(&self, cells: usize, fine: usize, a: f64, b: f64) -> AxisFactors {
+        let total = (self.columns * self.rows) as f64;
+        let c = cells as f64;
+        let q = geometric(a / c, cells) * geometric(b / c, cells).conj()
+            - geometric((a - b) / c, cells);
+        let d = geometric((a - b) / c, cells);
+        let offsets = uniform_char(a / total) * uniform_char(b / total).conj();
+        let r = distinct_pair_mean(a / total, b / total, fine);
+        let u = geometric((a - b) / total, fine) / fine as f64;
+        let coarse = uniform_char(a / c) * uniform_char(b / c).conj();
+        (q, d, offsets, r, u, coarse)
     }
 
-    fn pair_sum(&self, w1: [f64; 2], w2: [f64; 2]) -> Complex64 {
-        let (m, n) = (self.columns, self.rows);
-        let total = (m * n) as f64;
-        // Per axis: (coarse cells, fine intervals per cell, ω, ω′).
-        let axis = |cells: usize, fine: usize, a: f64, b: f64| {
-            let c = cells as f64;
-            let q = geometric(a / c, cells) * geometric(b / c, cells).conj()
-                - geometric((a - b) / c, cells);
-            let d = geometric((a - b) / c, cells);
-            let offsets = uniform_char(a / total) * uniform_char(b / total).conj();
-            let r = distinct_pair_mean(a / total, b / total, fine);
-            let u = geometric((a - b) / total, fine) / fine as f64;
-            let coarse = uniform_char(a / c) * uniform_char(b / c).conj();
-            (q, d, offsets, r, u, coarse)
-        };
-        let (qx, dx, cx, rx, ux, px) = axis(m, n, w1[0], w2[0]);
-        let (qy, dy, cy, ry, uy, py) = axis(n, m, w1[1], w2[1]);
+    fn x_factors(&self, a: f64, b: f64) -> AxisFactors {
+        self.axis_factors(self.columns, self.rows, a, b)
+    }
+
+    fn y_factors(&self, a: f64, b: f64) -> AxisFactors {
+        self.axis_factors(self.rows, self.columns, a, b)
+    }
+
+    /// C from the two axes' factors.
+    fn combine(&self, x: &AxisFactors, y: &AxisFactors) -> Complex64 {
+        let (qx, dx, cx, rx, ux, px) = *x;
+        let (qy, dy, cy, ry, uy, py) = *y;
         if self.correlated {
             cx * cy * (qx * qy * rx * ry + dx * qy * rx * uy + qx * dy * ux * ry)
         } else {
@@ -201,5 +218,28 @@ impl PairSpectrum for MultiJitter {
             let (within_x, within_y) = (dx * cx * rx, dy * cy * ry);
             pair_x * pair_y + within_x * pair_y + pair_x * within_y
         }
+    }
+}
+
+impl PairSpectrum for MultiJitter {
+    fn points(&self) -> usize {
+        self.points_per_set()
+    }
+
+    fn pair_sum(&self, w1: [f64; 2], w2: [f64; 2]) -> Complex64 {
+        self.combine(&self.x_factors(w1[0], w2[0]), &self.y_factors(w1[1], w2[1]))
+    }
+
+    /// Each axis's factors once per frequency of `xs` and of `ys`, then
+    /// combined: O(|xs| + |ys|) transcendental work instead of O(|xs|·|ys|).
+    fn power_grid(&self, xs: &[f64], ys: &[f64]) -> Vec<f64> {
+        let n = self.points_per_set() as f64;
+        let fy: Vec<AxisFactors> = ys.iter().map(|&b| self.y_factors(b, b)).collect();
+        let mut out = Vec::with_capacity(xs.len() * ys.len());
+        for &a in xs {
+            let fx = self.x_factors(a, a);
+            out.extend(fy.iter().map(|y| 1.0 + self.combine(&fx, y).re / n));
+        }
+        out
     }
 }

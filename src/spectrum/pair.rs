@@ -54,6 +54,14 @@ pub trait PairSpectrum: Send + Sync {
     fn power(&self, k: [f64; 2]) -> f64 {
         1.0 + self.pair_sum(k, k).re / self.points() as f64
     }
+    /// [`Self::power`] at every (x, y) of `xs` × `ys`, row-major by x (one
+    /// row per x). Samplers whose pair sums factor by axis override it to
+    /// compute each axis's part once.
+    fn power_grid(&self, xs: &[f64], ys: &[f64]) -> Vec<f64> {
+        xs.iter()
+            .flat_map(|&x| ys.iter().map(move |&y| self.power([x, y])))
+            .collect()
+    }
 }
 
 /// χ(w) = ∫₀¹ e^(2πiwt) dt = e^(πiw)·sinc(πw): the characteristic function

@@ -33,6 +33,13 @@
 //! an estimate from the data, not a theorem: it assumes the shell
 //! represents the frequencies beyond it.
 //!
+//! With a 2D closed-form expected spectrum ([`fourier_expected`]) the tail
+//! is summed exactly over the axis strips beyond the box, where N-rooks
+//! samplers are far from white ([`super::strips`]); the shell then leaves
+//! out its frequencies within the strips' half-width of an axis, and the
+//! bound adds the strips' continuation beyond their reach, twice their
+//! outer half's mean deviation over the rest's mass.
+//!
 //! Rounding: a set that integrates f exactly (uniform jitter on a smooth
 //! bump) has a Fourier variance of zero, and the computed one is what the
 //! arithmetic leaves. Two sources bound it. The transform's error is
@@ -59,6 +66,8 @@ use crate::points::PointSet;
 use crate::samplers::ClosedFormSpectrum;
 use crate::spectrum::{FrequencyBox, Method, Spectrum, expected_power_with};
 use crate::sum::NeumaierSum;
+
+use super::strips::{AxisStrips, axis_strips};
 
 /// Shell deviation |N·P_S − 1| above which the spectrum is treated as a
 /// lattice's, when N/4 is smaller (see the module doc).
@@ -91,6 +100,9 @@ pub struct FourierEstimate {
     pub half: usize,
     /// Realizations averaged (0 for a closed-form expected spectrum).
     pub sets: usize,
+    /// The axis strips beyond the box summed with a 2D closed form
+    /// ([`super::strips`]; already in `tail`), if any.
+    pub strips: Option<AxisStrips>,
 }
 
 /// P_f(k) over the box, in box order (parallel; each value independent).
@@ -222,9 +234,12 @@ where
         &|| {},
     )?;
     let counts = counts.into_inner().expect("no panics while held");
-    Ok(assemble(
-        f, tolerance, pf, spectrum, intensity, &counts, &per_set,
-    ))
+    let sums = SetSums {
+        intensity,
+        counts: &counts,
+        per_set: &per_set,
+    };
+    Ok(assemble(f, tolerance, pf, spectrum, sums, None))
 }
 
 /// The Fourier form with the sampler's closed-form expected power
@@ -278,22 +293,43 @@ pub fn fourier_expected(
         power,
         sets: 0,
     };
-    Ok(assemble(f, 0.0, pf, spectrum, n as f64, &[n], &[]))
+    let sums = SetSums {
+        intensity: n as f64,
+        counts: &[n],
+        per_set: &[],
+    };
+    let strips = axis_strips(f, closed, half);
+    Ok(assemble(f, 0.0, pf, spectrum, sums, strips))
+}
+
+/// What the realizations (or a closed form) bring beside the power.
+struct SetSums<'a> {
+    /// The normalisation: N, or the density λ of a random-count process.
+    intensity: f64,
+    /// Every set's N (one entry, N, for a closed form).
+    counts: &'a [usize],
+    /// Each set's in-box sum (none for a closed form).
+    per_set: &'a [f64],
 }
 
 /// The prediction from the expected power on the box: the in-box sum, the
 /// Parseval tail and its bound, the rounding bound, and the standard error
-/// from the per-set in-box sums `per_set` (none for a closed form: 0).
-/// `counts` holds every set's N (one entry, N, for a closed form).
+/// from the per-set in-box sums (none for a closed form: 0). With `strips`
+/// the tail is exact on them and the shell that estimates the rest leaves
+/// out its frequencies within the strips' half-width of an axis.
 fn assemble(
     f: &dyn Integrand,
     tolerance: f64,
     pf: Vec<f64>,
     spectrum: Spectrum,
-    intensity: f64,
-    counts: &[usize],
-    per_set: &[f64],
+    sums: SetSums,
+    strips: Option<AxisStrips>,
 ) -> FourierParts {
+    let SetSums {
+        intensity,
+        counts,
+        per_set,
+    } = sums;
     let freqs = spectrum.freqs;
     let half = freqs.half;
     let zero = freqs.zero_index();
@@ -303,12 +339,9 @@ fn assemble(
     let shell: Vec<(f64, f64)> = (0..freqs.len())
         .filter(|&idx| {
             freqs.frequency(idx, &mut k);
-            2 * k
-                .iter()
-                .map(|v| v.unsigned_abs() as usize)
-                .max()
-                .unwrap_or(0)
-                > half
+            let abs = k.iter().map(|v| v.unsigned_abs() as usize);
+            let on_strip = strips.is_some_and(|s| abs.clone().min().unwrap_or(0) <= s.width);
+            2 * abs.max().unwrap_or(0) > half && !on_strip
         })
         .map(|idx| (spectrum.power[idx] - 1.0, pf[idx]))
         .collect();
@@ -325,6 +358,8 @@ fn assemble(
     let count_bias = |c: usize| super::count_term(c, intensity, f.integral());
     let count_term = crate::sum::sum(counts.iter().map(|&c| count_bias(c))) / counts.len() as f64;
     let tail_mass = (f.variance() - mass.value()).max(0.0);
+    // What the shell's estimate must cover: the tail less the strips.
+    let rest_mass = (tail_mass - strips.map_or(0.0, |s| s.mass)).max(0.0);
     let (bias, spread, pf_max) = if shell.is_empty() {
         (1.0, 0.0, 0.0)
     } else {
@@ -345,18 +380,22 @@ fn assemble(
     let worst = shell.iter().map(|s| s.0.abs()).fold(0.0, f64::max);
     let dark = !shell.is_empty() && shell.iter().all(|s| s.0 + 1.0 < DARK_SHELL);
     let truncation_bound = if worst > LATTICE_SPIKE.max(0.25 * nf) {
-        worst * tail_mass / nf
+        worst * rest_mass / nf
     } else if dark {
         // |S(k)|² ≤ c² for c points: N·P_S = |S|²/λ ≤ c²/λ beyond the box.
         let largest = counts.iter().copied().max().unwrap_or(0) as f64;
-        (largest * largest / nf - 1.0).max(1.0) * tail_mass / nf
-    } else if tail_mass > mass.value() {
+        (largest * largest / nf - 1.0).max(1.0) * rest_mass / nf
+    } else if rest_mass > mass.value() {
         // Most of the energy lies beyond the box, where the shell's max P_f
         // says nothing: use the rigorous Σ_(k∉B) P_f² ≤ T².
-        (bias * tail_mass + 3.0 * spread * tail_mass) / nf
+        (bias * rest_mass + 3.0 * spread * rest_mass) / nf
     } else {
-        (bias * tail_mass + 3.0 * spread * (tail_mass * pf_max).sqrt()) / nf
-    };
+        (bias * rest_mass + 3.0 * spread * (rest_mass * pf_max).sqrt()) / nf
+    } + strips.map_or(0.0, |s| {
+        // The strips go on beyond their reach as their outer half did
+        // (doubled, as the shell's mean), over at most the rest's mass.
+        2.0 * s.outer_deviation.abs() * rest_mass / nf
+    });
     let rounding_bound = {
         let largest = counts.iter().copied().max().unwrap_or(0) as f64;
         let e = tolerance * largest;
@@ -368,7 +407,7 @@ fn assemble(
         (transform + 4.0 * f64::EPSILON * sums) / nf
     };
     let in_box = in_box.value() / nf;
-    let tail = tail_mass / nf;
+    let tail = (tail_mass + strips.map_or(0.0, |s| s.correction)) / nf;
     // Per-set values (in-box part and count term) for the standard error.
     let per_set: Vec<f64> = per_set
         .iter()
@@ -393,6 +432,7 @@ fn assemble(
             count_term,
             half,
             sets,
+            strips,
         },
         spectrum,
         integrand_power: pf,

@@ -16,6 +16,7 @@ pub mod paired;
 pub mod radial;
 pub mod sets;
 pub mod spatial;
+pub mod strips;
 
 pub use convergence::{SlopeError, SlopeFit, fit_slope, theoretical_rate};
 pub use empirical::{
