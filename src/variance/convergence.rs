@@ -16,12 +16,19 @@ pub struct SlopeFit {
     pub intercept: f64,
 }
 
+/// What rounding can put into a fitted slope: a least-squares slope of
+/// logarithms of values correct to ~1e-15 relative, far below this.
+pub const SLOPE_ROUNDING: f64 = 1e-9;
+
 impl SlopeFit {
     /// Whether the 95% interval excludes `rate` (false without an
-    /// interval, or without a rate).
+    /// interval, or without a rate). The interval is widened by
+    /// [`SLOPE_ROUNDING`]: a noiseless fit (a closed form, random sampling's
+    /// exact N^-1) has a zero-width interval that rounding alone moves off
+    /// the rate (−0.9999999999999997 against −1).
     pub fn excludes(&self, rate: Option<f64>) -> bool {
         match (rate, self.slope_ci) {
-            (Some(t), Some((low, high))) => t < low || t > high,
+            (Some(t), Some((low, high))) => t < low - SLOPE_ROUNDING || t > high + SLOPE_ROUNDING,
             _ => false,
         }
     }
@@ -171,6 +178,26 @@ pub fn theoretical_rate(sampler: &str, class: IntegrandClass, dim: usize) -> Opt
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_noiseless_fit_agrees_with_its_rate_to_rounding() {
+        // White noise's closed form, Var(f)/N, fitted over N = 64…1024:
+        // slope and interval came out −0.9999999999999997.
+        let exact = SlopeFit {
+            slope: -0.9999999999999997,
+            slope_ci: Some((-0.9999999999999997, -0.9999999999999997)),
+            intercept: 0.0,
+        };
+        assert!(!exact.excludes(Some(-1.0)));
+        // A real miss is still one, however narrow the interval.
+        assert!(exact.excludes(Some(-1.0001)));
+        let noisy = SlopeFit {
+            slope: -1.4,
+            slope_ci: Some((-1.43, -1.37)),
+            intercept: 0.0,
+        };
+        assert!(noisy.excludes(Some(-1.5)) && !noisy.excludes(Some(-1.4)));
+    }
 
     #[test]
     fn t_quantiles_match_scipy() {
