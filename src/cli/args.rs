@@ -59,8 +59,9 @@ pub const DEFAULT_SETS: usize = 16;
 /// which sampler parameters (shared by the commands that draw sets).
 #[derive(clap::Args)]
 pub struct DrawArgs {
-    /// Realizations to draw (with a sampler; default 16; predict draws more
-    /// when 16 leave its standard error above 5% of the variance).
+    /// Realizations to draw (with a sampler; default 16; without it,
+    /// `predict` alone draws more when 16 leave its standard error above 5%
+    /// of the variance).
     #[arg(value_parser = whole_at_least::<1, usize>, allow_negative_numbers = true, long = "sets", value_name = "SETS")]
     sets_given: Option<usize>,
     /// Seed (default 0): the same seed gives bit-identical realizations
