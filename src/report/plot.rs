@@ -356,7 +356,8 @@ pub struct HeatMap<'a> {
 /// the viridis colour map with a labelled colour bar (760×640 PNG).
 ///
 /// The colour range spans the powers at k ≠ 0: from the largest down at
-/// most four decades; DC (power N) is drawn in the top colour.
+/// most four decades; DC (power N, off any useful scale) is drawn grey,
+/// the colour of no value, so it does not read as low-frequency power.
 ///
 /// # Errors
 /// [`Error::Write`] naming `path`; a spectrum that is not 2D is refused the
@@ -403,7 +404,7 @@ pub fn power_png(
         .rev()
         .flat_map(|row| (0..side).map(move |col| row * side + col))
         .map(|idx| match spectrum.power[idx] {
-            _ if idx == zero => hi,
+            _ if idx == zero => f64::NAN,
             p if p <= 0.0 => lo,
             p => p.log10(),
         })
