@@ -31,7 +31,8 @@ Unknown fields are an error. Examples: experiments/rates.json,
 experiments/radial-failure.json.
 With \"kind\": \"figures\" the file lists figures instead (name, description,
 seed, figures: radial-spectra, spectrum, projections, ingredients,
-designed-projections, scene-variance, shear-convergence; docs/formats.md,
+designed-projections, scene-variance, scene-samplers, scene-pixels,
+shear-convergence; docs/formats.md,
 \"Figure experiments\"), e.g. experiments/seed-figures.json")]
 pub struct Args {
     /// Experiment file (JSON; fields in docs/formats.md): name, description,

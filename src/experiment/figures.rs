@@ -669,7 +669,7 @@ impl FigureExperiment {
                 let mut used = Vec::new();
                 for name in samplers {
                     let (s, m) = self.spectrum(name, *n, *sets, *res)?;
-                    used.push(format!("{name} (N = {m})"));
+                    used.push(format!("{name} ({})", size_used(*n, m)));
                     series.push(Series {
                         label: name.clone(),
                         points: radial_profile(&s)
@@ -707,7 +707,8 @@ impl FigureExperiment {
                     &out.join(file),
                 )?;
                 Ok(format!(
-                    "- `{file}`: E[N·P_S] of {sampler} at N = {m}, {sets} sets, box {res}².\n"
+                    "- `{file}`: E[N·P_S] of {sampler} at {}, {sets} sets, box {res}².\n",
+                    size_used(*n, m)
                 ))
             }
             Figure::Ingredients {
@@ -756,9 +757,10 @@ impl FigureExperiment {
                     &out.join(format!("{prefix}-product.png")),
                 )?;
                 Ok(format!(
-                    "- `{prefix}-{{sampling,integrand,product}}.png`: E[N·P_S] of {sampler} at N = {m} \
+                    "- `{prefix}-{{sampling,integrand,product}}.png`: E[N·P_S] of {sampler} at {} \
                      ({sets} sets), P_f of `{}` and their product; in-box sum \
                      (1/N) Σ_(k≠0) E[N·P_S]·P_f = {in_box:.4e} on the box {res}².\n",
+                    size_used(*n, m),
                     f.spec()
                 ))
             }
@@ -786,10 +788,11 @@ impl FigureExperiment {
                     drawn.sample(&mut set_rng(self.seed, r as u64))
                 })?;
                 Ok(format!(
-                    "- `{prefix}-{{{}}}.png`: E[N·P_S] of the {} projections of {what} at N = {m}, \
-                     {sets} sets, box {res}².\n",
-                    planes.join(","),
-                    planes.join(", ")
+                    "- `{}`: E[N·P_S] of the {} projections of {what} at {}, {sets} sets, box \
+                     {res}².\n",
+                    plane_files(prefix, planes),
+                    planes.join(", "),
+                    size_used(*n, m)
                 ))
             }
             Figure::DesignedProjections {
@@ -827,11 +830,11 @@ impl FigureExperiment {
                     );
                 }
                 Ok(format!(
-                    "- `{prefix}-{{{}}}.png`: E[N·P_S] of the {} projections of {sets} 4D sets of \
+                    "- `{}`: E[N·P_S] of the {} projections of {sets} 4D sets of \
                      N = {n} designed from umj for the projection target `{target}` (the seed's \
                      design principle: a target spectrum per projection), {} iterations at most; \
                      closest pair over the hexagonal spacing: XY {:.2}, UV {:.2}.\n\n{terms}",
-                    planes.join(","),
+                    plane_files(prefix, planes),
                     planes.join(", "),
                     design.max_iterations,
                     design.closest_pair_over_hexagonal.xy,
@@ -974,5 +977,24 @@ impl FigureExperiment {
                 ))
             }
         }
+    }
+}
+
+/// "N = m" for the N a sampler used, with the request beside it when the
+/// sampler's nearest valid N differs (a README must not hide the change).
+fn size_used(requested: usize, used: usize) -> String {
+    if requested == used {
+        format!("N = {used}")
+    } else {
+        format!("N = {used} ({requested} requested: the sampler's nearest valid N)")
+    }
+}
+
+/// The projection pictures' names: `PREFIX-xu.png` for one plane,
+/// `PREFIX-{xu,yv}.png` for several.
+fn plane_files(prefix: &str, planes: &[String]) -> String {
+    match planes {
+        [one] => format!("{prefix}-{one}.png"),
+        _ => format!("{prefix}-{{{}}}.png", planes.join(",")),
     }
 }

@@ -20,9 +20,17 @@ impl ExperimentFile {
     /// # Errors
     /// As [`Experiment::parse`] and [`FigureExperiment::parse`].
     pub fn parse(text: &str, file: &str) -> Result<Self, ExperimentError> {
-        let kind = serde_json::from_str::<serde_json::Value>(text)
-            .ok()
-            .and_then(|v| v.get("kind").and_then(|k| k.as_str()).map(str::to_owned));
+        // Not JSON at all (a trailing comma, a missing brace): say so here,
+        // before guessing a kind the file never got to name.
+        let value: serde_json::Value =
+            crate::io::from_json(text).map_err(|reason| ExperimentError::Invalid {
+                file: file.to_string(),
+                reason: format!("not valid JSON: {reason}"),
+            })?;
+        let kind = value
+            .get("kind")
+            .and_then(|k| k.as_str())
+            .map(str::to_owned);
         match kind.as_deref() {
             Some("figures") => FigureExperiment::parse(text, file).map(ExperimentFile::Figures),
             None | Some("variance") => Experiment::parse(text, file).map(ExperimentFile::Variance),

@@ -103,10 +103,12 @@ pub fn write_results(
         e.name, e.description
     );
     md += &format!(
-        "Sampler-level predictions of the shift-randomized estimator's variance, mean over {} realizations \
-         (seed {}; each N draws its own stream, `variances.csv`'s `seed` column) ± standard error; \
-         spatial form unless marked (F: Fourier form).\n\n",
-        e.sets, e.seed
+        "Sampler-level predictions of the shift-randomized estimator's variance, mean over {} \
+         realization{} (seed {}; each N draws its own stream, `variances.csv`'s `seed` column) ± \
+         standard error; spatial form unless marked (F: Fourier form).\n\n",
+        e.sets,
+        if e.sets == 1 { "" } else { "s" },
+        e.seed
     );
     let header: Vec<String> = functions
         .iter()

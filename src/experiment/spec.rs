@@ -164,10 +164,12 @@ impl Experiment {
             canonical.push(f.spec());
             dims.push(f.dim());
         }
-        if dims.iter().any(|&d| d != dims[0]) {
-            return Err(invalid(
-                "all integrands of an experiment must have the same dimension".into(),
-            ));
+        if let Some(i) = dims.iter().position(|&d| d != dims[0]) {
+            return Err(invalid(format!(
+                "all integrands of an experiment must have the same dimension: `{}` is {}D, \
+                 `{}` is {}D",
+                e.integrands[0], dims[0], e.integrands[i], dims[i]
+            )));
         }
         if let Some(r) = e.radial {
             if let Some(spec) = e

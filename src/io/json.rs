@@ -34,9 +34,13 @@ pub fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, String> {
     }
     let mut de = serde_json::Deserializer::from_str(text);
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-        let path = e.path().to_string();
+        // A last segment "?" is serde_path_to_error's unknown place (a
+        // syntax error inside a tagged enum): keep the known part; the
+        // message's line and column say where.
+        let full = e.path().to_string();
+        let path = full.trim_end_matches('?').trim_end_matches('.');
         let message = plain_message(e.inner(), text);
-        if path == "." {
+        if path.is_empty() {
             message
         } else {
             format!("{path}: {message}")
