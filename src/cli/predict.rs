@@ -107,7 +107,8 @@ pub struct Args {
     /// scene pixel, the estimator its render uses].
     #[arg(long, value_enum, conflicts_with = "family")]
     shift: Option<ShiftArg>,
-    /// Fourier box |k| < K/2 (default 256 in 2D, 16 in 4D).
+    /// Fourier box |k| < K/2 (default 256 in 2D, 21 in 4D: the box of
+    /// converge and experiment).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// NUFFT tolerance of the Fourier predictor's spectrum [default: 1e-10].
@@ -292,7 +293,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         // Without --res the closed form's box is the Fourier form's, grown
         // with N where that matters (variance::expected_min_half).
         let res = a.res.unwrap_or_else(|| {
-            let fourier = if f.dim() == 2 { 256 } else { 16 };
+            let fourier = default_res(f.dim());
             fourier.max(2 * expected_min_half(f.dim(), n) + 1)
         });
         let start = Instant::now();
@@ -532,7 +533,7 @@ fn set_forms(
         }
     };
     if wants(MethodArg::Fourier) || wants(MethodArg::Radial) {
-        let res = a.res.unwrap_or(if f.dim() == 2 { 256 } else { 16 });
+        let res = a.res.unwrap_or(default_res(f.dim()));
         let half = res.saturating_sub(1) / 2;
         let start = Instant::now();
         let bar = progress::bar(sets as u64, "Fourier form, sets");
@@ -666,4 +667,14 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The Fourier box K without --res: 256 in 2D (half-width 127), and in 4D
+/// the box of converge and experiment, 2·10 + 1 (variance::fourier_half).
+fn default_res(dim: usize) -> usize {
+    if dim == 2 {
+        256
+    } else {
+        2 * varspec::variance::fourier_half(dim) + 1
+    }
 }
