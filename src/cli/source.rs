@@ -28,7 +28,8 @@ pub struct SourceArgs {
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: Option<usize>,
     /// Sampler dimension (with --sampler; default: the dimension the
-    /// analysis needs where the sampler has it, else the sampler's own).
+    /// analysis needs where the sampler has it, 4 for a --dims plane with an
+    /// index of 2 or 3, else the sampler's own).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, short = 'd', long = "dim")]
     dim: Option<usize>,
     #[command(flatten)]
@@ -122,11 +123,18 @@ impl SourceArgs {
                 }
                 self.draw.check_results_memory()?;
                 let n = self.n.context("--sampler needs -n")?;
-                // Without -d or --dims, draw in the dimension the analysis
-                // needs where the sampler has it (as `converge` does): jitter
-                // for a 4D integrand is 4D jitter. A sampler without it
-                // keeps its own, and the check below says what to do.
-                let wanted = self.dim.or(dim.filter(|_| dims.is_none()));
+                // Without -d, draw in the dimension the analysis needs
+                // where the sampler has it (as `converge` does): jitter for
+                // a 4D integrand is 4D jitter; with --dims, enough for its
+                // largest index (--dims 0,2 is the XU plane of 4D sets, the
+                // dimension the projections are named in). A sampler
+                // without it keeps its own, and the check below says what
+                // to do.
+                let for_plane = dims
+                    .as_ref()
+                    .and_then(|d| d.iter().max())
+                    .map(|&top| if top < 2 { 2 } else { 4.max(top + 1) });
+                let wanted = self.dim.or(for_plane).or(dim);
                 let sampler = match registry::build(name, n, wanted, &self.draw.params) {
                     Err(varspec::samplers::SamplerError::Dimension { .. })
                         if self.dim.is_none() =>
@@ -179,9 +187,15 @@ impl SourceArgs {
                     source.name()
                 );
             }
+            let example = if found == 4 {
+                " (0,2 is XU, 1,3 is YV)".to_string()
+            } else {
+                let first: Vec<String> = (0..dim).map(|i| i.to_string()).collect();
+                format!(", e.g. --dims {}", first.join(","))
+            };
             bail!(
-                "{}: points are {found}-dimensional where {dim} dimensions are needed; choose a projection with --dims \
-                 (0,2 is XU, 1,3 is YV)",
+                "{}: points are {found}-dimensional where {dim} dimensions are needed; choose a \
+                 projection with --dims{example}",
                 source.name()
             );
         }
