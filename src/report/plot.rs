@@ -190,8 +190,14 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
                         .draw_series(LineSeries::new(data, style))
                         .map_err(draw_error)?
                 };
+                // The key drawn as the series is: a dashed reference line as
+                // two dashes, data as a solid line.
+                let (gap, width) = if s.reference { (6, 1) } else { (0, 2) };
                 anno.label(s.label.as_str()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(2))
+                    let key = colour.stroke_width(width);
+                    EmptyElement::at((x, y))
+                        + PathElement::new(vec![(0, 0), (12 - gap / 2, 0)], key)
+                        + PathElement::new(vec![(12 + gap / 2, 0), (24, 0)], key)
                 });
             }
             chart
