@@ -149,30 +149,7 @@ impl Sampler for MultiJitter {
     }
 }
 
-/// C(ω, ω′) in closed form. The x coordinates depend only on the σ shuffles
-/// and x offsets, the y coordinates only on τ and the y offsets, so each
-/// pair's expectation is an x factor times a y factor, and the sum over the
-/// pairs (i, j) ≠ (i′, j′) splits into three cases — other column and other
-/// row (A), same column (B), same row (C) — each a product of geometric
-/// sums over columns, rows and fine intervals.
-///
-/// Multi-jitter (σ_i, τ_j independent per column and row): a point of
-/// column i is uniform over the column, two points of one column sit in
-/// distinct fine intervals drawn without replacement:
-/// C = P_x·P_y + W_x·P_y + P_x·W_y, with P_x = χ(ω_x/m)conj(χ(ω′_x/m))·Q_x
-/// (pairs of distinct columns) and W_x = D_x·χ(ω_x/N)conj(χ(ω′_x/N))·R_x
-/// (pairs within a column).
-///
-/// CMJ (one σ, one τ): the fine interval of x depends on the row j only, so
-/// two points in distinct rows have distinct σ values (R_x) and two in one
-/// row share it (U_x):
-/// C = c_x c_y (Q_x Q_y R_x R_y + D_x Q_y R_x U_y + Q_x D_y U_x R_y).
-///
-/// Here Q_x = Σ_(i≠i′) e^(2πi(ω_x i − ω′_x i′)/m), D_x = Σ_i e^(2πi(ω_x−ω′_x)i/m),
-/// R_x the mean of e^(2πi(ω_x t − ω′_x t′)/N) over distinct t, t′ < n,
-/// U_x = (1/n) Σ_(t<n) e^(2πi(ω_x−ω′_x)t/N), c_x = χ(ω_x/N)conj(χ(ω′_x/N)),
-/// and the y terms likewise with the roles of m and n exchanged.
-/// One axis's factors of C(ω, ω′) (the names of the doc above):
+/// One axis's factors of C(ω, ω′) (the names of the `PairSpectrum` impl's doc):
 /// (Q, D, c, R, U, χ(ω/cells)·conj(χ(ω′/cells))).
 type AxisFactors = (
     Complex64,
@@ -189,9 +166,8 @@ impl MultiJitter {
     fn axis_factors(&self, cells: usize, fine: usize, a: f64, b: f64) -> AxisFactors {
         let total = (self.columns * self.rows) as f64;
         let c = cells as f64;
-        let q = geometric(a / c, cells) * geometric(b / c, cells).conj()
-            - geometric((a - b) / c, cells);
         let d = geometric((a - b) / c, cells);
+        let q = geometric(a / c, cells) * geometric(b / c, cells).conj() - d;
         let offsets = uniform_char(a / total) * uniform_char(b / total).conj();
         let r = distinct_pair_mean(a / total, b / total, fine);
         let u = geometric((a - b) / total, fine) / fine as f64;
@@ -221,6 +197,29 @@ impl MultiJitter {
     }
 }
 
+/// C(ω, ω′) in closed form. The x coordinates depend only on the σ shuffles
+/// and x offsets, the y coordinates only on τ and the y offsets, so each
+/// pair's expectation is an x factor times a y factor, and the sum over the
+/// pairs (i, j) ≠ (i′, j′) splits into three cases — other column and other
+/// row (A), same column (B), same row (C) — each a product of geometric
+/// sums over columns, rows and fine intervals.
+///
+/// Multi-jitter (σ_i, τ_j independent per column and row): a point of
+/// column i is uniform over the column, two points of one column sit in
+/// distinct fine intervals drawn without replacement:
+/// C = P_x·P_y + W_x·P_y + P_x·W_y, with P_x = χ(ω_x/m)conj(χ(ω′_x/m))·Q_x
+/// (pairs of distinct columns) and W_x = D_x·χ(ω_x/N)conj(χ(ω′_x/N))·R_x
+/// (pairs within a column).
+///
+/// CMJ (one σ, one τ): the fine interval of x depends on the row j only, so
+/// two points in distinct rows have distinct σ values (R_x) and two in one
+/// row share it (U_x):
+/// C = c_x c_y (Q_x Q_y R_x R_y + D_x Q_y R_x U_y + Q_x D_y U_x R_y).
+///
+/// Here Q_x = Σ_(i≠i′) e^(2πi(ω_x i − ω′_x i′)/m), D_x = Σ_i e^(2πi(ω_x−ω′_x)i/m),
+/// R_x the mean of e^(2πi(ω_x t − ω′_x t′)/N) over distinct t, t′ < n,
+/// U_x = (1/n) Σ_(t<n) e^(2πi(ω_x−ω′_x)t/N), c_x = χ(ω_x/N)conj(χ(ω′_x/N)),
+/// and the y terms likewise with the roles of m and n exchanged.
 impl PairSpectrum for MultiJitter {
     fn points(&self) -> usize {
         self.points_per_set()
