@@ -410,14 +410,10 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
         );
     }
     for (name, v) in &design.comparison {
-        let exact = match (name.as_str(), v["exact_variance"].as_f64()) {
-            ("optimized", _) => design
-                .exact_variance
-                .map(|e| format!("  exact variance {e:.4e}"))
-                .unwrap_or_default(),
-            (_, Some(e)) => format!("  exact variance {e:.4e}"),
-            _ => String::new(),
-        };
+        let exact = v["exact_variance"]
+            .as_f64()
+            .map(|e| format!("  exact variance {e:.4e}"))
+            .unwrap_or_default();
         outln!(
             "  {name:<14} loss {:.4e}{exact}",
             v["loss"].as_f64().unwrap_or(f64::NAN)
@@ -653,13 +649,30 @@ fn report_shear_outputs(a: &ShearArgs, pixel: bool) {
 fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::integrands::Integrand;
     use varspec::scene::pixel::PixelIntegrand;
+    use varspec::scene::pixel_shear::MIN_REALIZATIONS;
     use varspec::scene::pixel_shear::{Measured, PixelShearOptions, search_pixel_shear};
+    if let Some(range) = a.range {
+        bail!(
+            "--range {range}: a scene pixel's candidate shears come from its local analysis \
+             (the depths its rays meet), not from a searched range; --range applies to \
+             light-field integrands (defocus, layers)"
+        );
+    }
+    if a.realizations < MIN_REALIZATIONS {
+        bail!(
+            "--realizations {}: on a scene pixel it is the first round of realizations every \
+             candidate shear is measured on (more are added until the best is known to 2%); \
+             pixel estimates take few distinct values, so fewer than {MIN_REALIZATIONS} can \
+             agree by chance and fake a variance of 0",
+            a.realizations
+        );
+    }
     let f = PixelIntegrand::parse(&a.integrand)?;
     let sampler = registry::build(&a.sampler, a.n, Some(4), &[])?;
     let start = Instant::now();
     let options = PixelShearOptions {
         seed: a.seed,
-        min_realizations: a.realizations.max(2),
+        min_realizations: a.realizations,
         ..PixelShearOptions::default()
     };
     let spinner = progress::spinner("searching the pixel's shear");
@@ -734,6 +747,14 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
             m.shear.amounts()[1],
             e.variance,
             e.stderr
+        );
+    }
+    if found.candidates.len() == 1 {
+        let why = f.scene().why_no_slope().unwrap_or(
+            "every probe ray missed the geometry (a constant pixel) or met depths in focus",
+        );
+        eprintln!(
+            "note: only the unsheared set was measured: {why}, so the pixel has no light-field slope to shear along"
         );
     }
     outln!(

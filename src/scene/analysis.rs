@@ -14,7 +14,6 @@
 //! aligns; a pixel whose rays all miss sees the constant background.
 
 use super::Scene;
-use super::description::IntegrandKind;
 use crate::optimize::shear::shear_set;
 use crate::points::PointSet;
 use crate::rng::PREV_ONE;
@@ -235,7 +234,7 @@ impl FootprintSlopes {
     /// depth through a lens.
     pub fn probe(scene: &Scene, px: usize, py: usize, a: &PixelAnalysis, n: usize) -> Self {
         let mut range = [a.kappa, a.kappa];
-        if through_a_lens(scene) && a.kind == PixelKind::Single {
+        if scene.why_no_slope().is_none() && a.kind == PixelKind::Single {
             let d0 = a.depth;
             for x in FOOTPRINT_PIXEL {
                 for y in FOOTPRINT_PIXEL {
@@ -278,13 +277,6 @@ impl FootprintSlopes {
     }
 }
 
-/// Whether the scene's (u, v) are on a lens with an aperture (not a pinhole,
-/// not the soft-shadow integrand's light): only then does a pixel's light
-/// field have a slope κ.
-fn through_a_lens(scene: &Scene) -> bool {
-    scene.integrand() == IntegrandKind::Lens && scene.has_aperture()
-}
-
 /// The depth of the closest hit of pixel (px, py)'s ray at sample
 /// (x, y, u, v), if any.
 fn depth_at(scene: &Scene, px: usize, py: usize, sample: [f64; 4]) -> Option<f64> {
@@ -301,7 +293,7 @@ fn depth_at(scene: &Scene, px: usize, py: usize, sample: [f64; 4]) -> Option<f64
 /// integrand).
 pub fn analyse_pixel(scene: &Scene, px: usize, py: usize) -> PixelAnalysis {
     let camera = scene.camera();
-    let lens = through_a_lens(scene);
+    let lens = scene.why_no_slope().is_none();
     let probes: Vec<[f64; 2]> = if lens {
         PROBES
             .iter()

@@ -88,7 +88,7 @@ impl Light {
             bitangent,
             size: l.size,
             radiance: l.radiance,
-            sampling: l.sampling,
+            sampling: l.sampling(),
         }
     }
 
@@ -280,6 +280,19 @@ impl Scene {
     /// Whether the lens has an area (aperture > 0).
     pub fn has_aperture(&self) -> bool {
         self.file.camera.aperture > 0.0
+    }
+
+    /// Why the scene's pixels have no light-field slope κ, so that every
+    /// analytic shear is none (`None`: (u, v) are on a lens with an area,
+    /// and a pixel's slope follows its depth).
+    pub fn why_no_slope(&self) -> Option<&'static str> {
+        if self.integrand() == IntegrandKind::Light {
+            Some("its (u, v) sample the light (soft shadows through a pinhole camera), not a lens")
+        } else if !self.has_aperture() {
+            Some("its camera is a pinhole (aperture 0)")
+        } else {
+            None
+        }
     }
 
     /// What (u, v) sample.

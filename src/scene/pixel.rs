@@ -109,8 +109,15 @@ impl PixelIntegrand {
         let (name, params) = rest
             .split_once(',')
             .ok_or_else(|| fail("no pixel given".into()))?;
-        if name.is_empty() {
-            return Err(fail("no scene name".into()));
+        if name.is_empty() || name.contains('=') {
+            return Err(fail(format!(
+                "no scene name (the built-in scenes: {})",
+                crate::scene::BUILTIN_SCENES
+                    .iter()
+                    .map(|s| s.0)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
         }
         let (mut px, mut py) = (None, None);
         for (key, value) in
@@ -130,7 +137,8 @@ impl PixelIntegrand {
             }
             let v: usize = value.parse().map_err(|_| {
                 fail(format!(
-                    "{key} = {value}: a pixel index, a whole number >= 0"
+                    "{key} = {value}: a pixel index is written in digits, counted from 0 \
+                     (px from the left, py from the top)"
                 ))
             })?;
             *slot = Some(v);

@@ -188,8 +188,10 @@ impl<'a> ShearObjective<'a> {
         })?;
         let [xy_half, uv_half] = sampler.halves().ok_or_else(|| {
             OptimizeError::Option(
-                "the shear search needs a padded 4D sampler with independent (x, y) and (u, v) \
-                 halves: umj or padded:xy=...,uv=..."
+                "the shear search on a light field needs a padded 4D sampler with independent \
+                 (x, y) and (u, v) halves (its expected variance is computed from theirs): umj or \
+                 padded:xy=...,uv=... (on a scene pixel, where each candidate's variance is \
+                 measured, any 4D sampler)"
                     .into(),
             )
         })?;
