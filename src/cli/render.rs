@@ -11,6 +11,7 @@ use varspec::io::write_atomic;
 use varspec::optimize::shear::MAX_SHEAR_RANGE;
 use varspec::registry;
 use varspec::report::plot::{HeatMap, heatmap_png};
+use varspec::samplers::Sampler;
 use varspec::scene::analysis::{PixelKind, SampleShear};
 use varspec::scene::image::GreyImage;
 use varspec::scene::render::{
@@ -90,8 +91,8 @@ pub struct Args {
     /// Sampler parameter key=value (repeatable).
     #[arg(long = "param", value_parser = args::key_value)]
     params: Vec<(String, String)>,
-    /// List the built-in scenes.
-    #[arg(long)]
+    /// List the built-in scenes (and nothing else: no scene is rendered).
+    #[arg(long, conflicts_with = "scene")]
     list: bool,
 }
 
@@ -194,6 +195,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         None => None,
     };
+    if let (ShearPolicy::Analytic | ShearPolicy::Pilot { .. }, Some(why)) =
+        (policy, scene.why_no_slope())
+    {
+        eprintln!(
+            "note: --shear {} leaves every pixel unsheared on {}: {why}, so no pixel has a light-field slope",
+            a.shear,
+            scene.name()
+        );
+    }
+    warn_slow_sets(sampler.as_ref(), &a.sampler, a.seed, w * h * a.renders)?;
     let start = Instant::now();
     let analysis = analyse(&scene);
     let shears = pixel_shears(&scene, sampler.as_ref(), policy, &analysis, a.seed)?;
@@ -296,9 +307,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 values: &values,
                 width: w,
                 x_range: (0.0, w as f64),
-                y_range: (0.0, h as f64),
+                y_range: (h as f64, 0.0),
                 x_label: "pixel x".into(),
-                y_label: "pixel y (from the bottom)".into(),
+                y_label: "pixel y (from the top)".into(),
                 bar_label: "κ (pixels per unit u)".into(),
                 colour_range: (-lim, lim),
             },
@@ -398,5 +409,44 @@ fn log_range(text: &str) -> Result<(f64, f64), String> {
         _ => Err(format!(
             "expected LO,HI: two finite numbers with LO < HI (log10 variance, e.g. -6,-2), got `{text}`"
         )),
+    }
+}
+
+/// Draws one set and, when the render's sets would take more than
+/// [`SLOW_DRAWING`] seconds in all, says how long before it starts
+/// (optimized samplers such as blue-noise descend per set: a 4-point 4D set
+/// takes seconds, a 256×256 image hours).
+fn warn_slow_sets(sampler: &dyn Sampler, name: &str, seed: u64, sets: usize) -> anyhow::Result<()> {
+    let start = Instant::now();
+    sampler.sample(&mut varspec::rng::set_rng(seed, 0))?;
+    let one = start.elapsed().as_secs_f64();
+    let threads = rayon::current_num_threads();
+    let total = one * sets as f64 / threads as f64;
+    if total > SLOW_DRAWING {
+        eprintln!(
+            "note: one {} set takes {} to draw; {sets} sets (pixels × renders) on {threads} \
+             thread(s) take about {} before any ray is traced",
+            name,
+            if one >= 1.0 {
+                format!("{one:.1} s")
+            } else {
+                format!("{:.2} ms", one * 1e3)
+            },
+            hours_minutes(total)
+        );
+    }
+    Ok(())
+}
+
+/// Seconds of set drawing above which [`warn_slow_sets`] speaks.
+const SLOW_DRAWING: f64 = 30.0;
+
+/// `total` seconds as "N h M min" or "M min".
+fn hours_minutes(total: f64) -> String {
+    let minutes = (total / 60.0).round();
+    if minutes >= 60.0 {
+        format!("{} h {} min", (minutes / 60.0).floor(), minutes % 60.0)
+    } else {
+        format!("{} min", minutes.max(1.0))
     }
 }

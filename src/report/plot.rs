@@ -344,7 +344,8 @@ pub struct HeatMap<'a> {
     pub values: &'a [f64],
     /// Cells per row.
     pub width: usize,
-    /// The axes' value ranges (left to right, bottom to top).
+    /// The axes' value ranges (left to right, bottom to top; a falling
+    /// y range numbers rows from the top, as image coordinates do).
     pub x_range: (f64, f64),
     /// See `x_range`.
     pub y_range: (f64, f64),
