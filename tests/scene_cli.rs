@@ -242,6 +242,12 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
             "\"aperture\": -Infinity",
             "camera.aperture: `-Infinity` is not a JSON value (JSON has no NaN or infinities",
         ),
+        // Fields that mean nothing where they stand were read and ignored.
+        (
+            "\"scale\": [6, 6, 1]",
+            "\"scale\": [6, 6, 1], \"subdivisions\": 2",
+            "objects[0].subdivisions = 2: only with shape `sphere`",
+        ),
     ];
     for (from, to, phrase) in cases {
         assert!(base.contains(from), "{from}");
@@ -260,6 +266,25 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
         std::fs::write(&path, text).unwrap();
         assert_fails(&["render", path.to_str().unwrap()], phrase);
     }
+    let square = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/shadows-square.json"
+    ))
+    .unwrap();
+    let path = dir.join("square-sampling.json");
+    std::fs::write(
+        &path,
+        square.replacen(
+            "\"radiance\": 15.0",
+            "\"radiance\": 15.0, \"sampling\": \"bounding_square\"",
+            1,
+        ),
+    )
+    .unwrap();
+    assert_fails(
+        &["render", path.to_str().unwrap()],
+        "lights[0].sampling = \"bounding_square\": only for a `disk` light",
+    );
     assert_fails(&["render", "nosuchscene"], "neither a built-in scene (dof,");
     assert_fails(
         &["render", "dof", "--sampler", "cmj"],

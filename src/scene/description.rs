@@ -80,9 +80,10 @@ pub struct ObjectFile {
     /// Translation, applied last.
     #[serde(default)]
     pub translate: [f64; 3],
-    /// Sphere tessellation: subdivisions of an icosahedron (0 to 7).
-    #[serde(default = "default_subdivisions")]
-    pub subdivisions: u32,
+    /// Sphere tessellation: subdivisions of an icosahedron (0 to 7; only for
+    /// `sphere`, default [`DEFAULT_SUBDIVISIONS`]).
+    #[serde(default)]
+    pub subdivisions: Option<u32>,
     /// The diffuse material.
     pub material: MaterialFile,
 }
@@ -91,8 +92,14 @@ fn unit_scale() -> [f64; 3] {
     [1.0; 3]
 }
 
-fn default_subdivisions() -> u32 {
-    3
+/// A sphere's subdivisions when the file gives none (1280 triangles).
+pub const DEFAULT_SUBDIVISIONS: u32 = 3;
+
+impl ObjectFile {
+    /// The icosahedron subdivisions of a sphere.
+    pub fn subdivisions(&self) -> u32 {
+        self.subdivisions.unwrap_or(DEFAULT_SUBDIVISIONS)
+    }
 }
 
 /// Built-in mesh shapes.
@@ -232,9 +239,16 @@ pub struct LightFile {
     /// the concentric map) or `bounding_square` (uniform on the square
     /// around it, points off a disk contributing nothing: the disk's edge
     /// then is a discontinuity in (u, v), as in the seed's light
-    /// experiments).
+    /// experiments). Only for a disk: a square is its own bounding square.
     #[serde(default)]
-    pub sampling: LightSampling,
+    pub sampling: Option<LightSampling>,
+}
+
+impl LightFile {
+    /// How (u, v) reach the light (`area` when the file does not say).
+    pub fn sampling(&self) -> LightSampling {
+        self.sampling.unwrap_or_default()
+    }
 }
 
 /// How a light's (u, v) map onto it.
@@ -436,12 +450,22 @@ impl SceneFile {
                     ));
                 }
             }
-            if o.subdivisions > 7 {
-                return Err(bad(
-                    field("subdivisions"),
-                    o.subdivisions.to_string(),
-                    "0 to 7 (7 is 327,680 triangles)",
-                ));
+            match (o.shape, o.subdivisions) {
+                (ShapeKind::Sphere, Some(s)) if s > 7 => {
+                    return Err(bad(
+                        field("subdivisions"),
+                        s.to_string(),
+                        "0 to 7 (7 is 327,680 triangles)",
+                    ));
+                }
+                (ShapeKind::Sphere, _) | (_, None) => {}
+                (_, Some(s)) => {
+                    return Err(bad(
+                        field("subdivisions"),
+                        s.to_string(),
+                        "only with shape `sphere` (the other shapes are not tessellated)",
+                    ));
+                }
             }
             o.material.check().map_err(|(name, value, expected)| {
                 bad(field(&format!("material.{name}")), value, expected)
@@ -462,6 +486,17 @@ impl SceneFile {
                     field("size"),
                     SpecValue(l.size).to_string(),
                     &format!("a positive size of at most {MAX_LENGTH:e}"),
+                ));
+            }
+            if l.shape == LightShape::Square && l.sampling.is_some() {
+                return Err(bad(
+                    field("sampling"),
+                    match l.sampling() {
+                        LightSampling::Area => "\"area\"",
+                        LightSampling::BoundingSquare => "\"bounding_square\"",
+                    }
+                    .into(),
+                    "only for a `disk` light (a square light is its own bounding square)",
                 ));
             }
             if !(l.radiance >= 0.0 && l.radiance <= MAX_RADIANCE) {

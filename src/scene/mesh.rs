@@ -32,7 +32,7 @@ pub fn object_triangles(
     source_name: &str,
     folder: &Path,
 ) -> Result<Vec<ModelTriangle>, SceneError> {
-    let triangles = match shape_triangles(object.shape, object.subdivisions) {
+    let triangles = match shape_triangles(object.shape, object.subdivisions()) {
         Some(triangles) => triangles,
         None => {
             let file = object.file.clone().unwrap_or_default();
