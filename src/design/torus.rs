@@ -353,6 +353,14 @@ impl TorusPlan {
             }
         }
         let exact: Option<Vec<f64>> = results.iter().map(Kept::variance).collect();
+        if let (Some(v), Some(entry)) = (
+            exact.as_deref(),
+            comparison
+                .get_mut("optimized")
+                .and_then(|e| e.as_object_mut()),
+        ) {
+            entry.insert("exact_variance".into(), json!(mean(v)));
+        }
         let half = self.optimizer.frequencies().half;
         Ok(TorusDesign {
             points: results.iter().map(|k| k.points.clone()).collect(),
