@@ -2,7 +2,7 @@
 //! use them: the JSON keys of docs/cli.md, errors, determinism.
 
 use crate::common;
-use common::{varspec, varspec_with};
+use common::{varspec, varspec_ok, varspec_with};
 
 fn json(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&common::varspec_ok(args).stdout).expect("one JSON object")
@@ -1043,5 +1043,69 @@ fn loose_truncation_bounds_are_named() {
         out.stderr.is_empty(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// `converge --dims`: the XU and YV planes of umj sets are Latin hypercubes
+/// (x and u each stratified in N columns by its own multi-jittered pattern,
+/// the two patterns paired at random), so their variances are N-rooks
+/// sets' at every N; the XY plane (multi-jitter) lies far below. A wrong
+/// projection (the XY plane, or unprojected 4D sets) fails one or the other.
+#[test]
+fn converge_on_a_plane_fits_the_projection() {
+    // Two-sided 99.99% for each of the four comparisons.
+    const Z: f64 = 3.89;
+    let run = |sampler: &str, dims: &[&str]| -> Vec<(f64, f64)> {
+        let mut args = vec![
+            "converge",
+            "--sampler",
+            sampler,
+            "-n",
+            "64,256",
+            "--integrand",
+            "disk",
+            "--sets",
+            "256",
+            "--json",
+        ];
+        args.extend(dims);
+        let out: serde_json::Value =
+            serde_json::from_slice(&varspec_ok(&args).stdout).expect("one JSON object");
+        out["points"]
+            .as_array()
+            .expect("points")
+            .iter()
+            .map(|p| {
+                (
+                    p["variance"].as_f64().unwrap(),
+                    p["stderr"].as_f64().unwrap(),
+                )
+            })
+            .collect()
+    };
+    let rooks = run("nrooks", &[]);
+    for plane in ["0,2", "1,3"] {
+        for (n, (a, b)) in [64, 256]
+            .iter()
+            .zip(run("umj", &["--dims", plane]).iter().zip(&rooks))
+        {
+            let se = (a.1 * a.1 + b.1 * b.1).sqrt();
+            assert!(
+                (a.0 - b.0).abs() <= Z * se,
+                "N = {n}, plane {plane}: umj {:.4e} vs nrooks {:.4e}, 99.99% CI of the difference ±{:.2e}",
+                a.0,
+                b.0,
+                Z * se
+            );
+        }
+    }
+    let xy = run("umj", &["--dims", "0,1"]);
+    assert!(
+        xy[1].0 + Z * xy[1].1 < 0.5 * (rooks[1].0 - Z * rooks[1].1),
+        "N = 256: the XY plane {:.4e} ± {:.1e} should be far below N-rooks {:.4e} ± {:.1e}",
+        xy[1].0,
+        xy[1].1,
+        rooks[1].0,
+        rooks[1].1
     );
 }

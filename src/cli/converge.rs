@@ -49,6 +49,11 @@ pub struct Args {
     /// Integrand spec (the torus, shift-randomized estimator).
     #[arg(long)]
     integrand: Option<String>,
+    /// Fit the projection of the sets onto these dimensions, e.g. 0,2 (XU)
+    /// or 1,3 (YV), one index per dimension of the integrand; a sampler
+    /// then draws 4D sets when an index is 2 or more.
+    #[arg(long)]
+    dims: Option<String>,
     /// Instead: a family of integrands on the unit square (gaussians,
     /// halfplanes, disks, boxes, file:PATH) and the unshifted estimator's
     /// mean squared error over it, by brute force over the members.
@@ -135,6 +140,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Subject::Torus(f) => (f.dim(), f.spec()),
         Subject::Square(family) => (2, family.spec()),
     };
+    let plane = a
+        .dims
+        .as_deref()
+        .map(|d| super::args::dims(d, dim))
+        .transpose()?;
+    // The sets' own dimension: the integrand's, or enough for the plane's
+    // largest index (4D when it names u or v, as the projections do).
+    let draw_dim = plane
+        .as_ref()
+        .and_then(|p| p.iter().max())
+        .map_or(dim, |&top| if top < dim { dim } else { 4.max(top + 1) });
     let levels: Vec<Level> = if a.points.is_empty() {
         a.ns.iter().map(|&n| Level::Sampler(n)).collect()
     } else {
@@ -169,6 +185,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
              --sampler (not --points)"
         );
     }
+    if method == MethodArg::Expected && plane.is_some() {
+        bail!(
+            "--dims with --method expected: the closed-form expected spectrum is of the \
+             sampler's own sets, not of a projection; use --method spatial or fourier"
+        );
+    }
     if method == MethodArg::Expected && a.draw.sets_were_given() {
         bail!("--sets: --method expected draws no sets (the expectation is in closed form)");
     }
@@ -187,17 +209,32 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let (source, requested, seed) = match level {
             Level::Sampler(requested) => {
                 let sampler_name = a.sampler.as_deref().unwrap_or_default();
-                let (sampler, _) = registry::build_nearest(
-                    sampler_name,
-                    *requested,
-                    Some(dim),
-                    &a.draw.params,
-                )
+                let build =
+                    |d| registry::build_nearest(sampler_name, *requested, d, &a.draw.params);
+                // A plane of a sampler's own larger sets (--dims 0,1 of
+                // umj's 4D sets) is drawn in the sampler's dimension.
+                let (sampler, _) = match (build(Some(draw_dim)), &plane) {
+                    (Err(varspec::samplers::SamplerError::Dimension { .. }), Some(p)) => {
+                        build(None).and_then(|(s, n)| {
+                            let top = p.iter().max().copied().unwrap_or(0);
+                            if s.dim() > top {
+                                Ok((s, n))
+                            } else {
+                                build(Some(draw_dim))
+                            }
+                        })
+                    }
+                    (built, _) => built,
+                }
                 .map_err(|e| match e {
-                    varspec::samplers::SamplerError::Dimension { max, .. } if max < dim => {
+                    varspec::samplers::SamplerError::Dimension { max, .. } if max < draw_dim => {
+                        let what = match &a.dims {
+                            Some(d) => format!("the plane --dims {d}"),
+                            None => format!("{name} is {dim}-dimensional and"),
+                        };
                         anyhow::anyhow!(
-                            "{e}: {name} is {dim}-dimensional; use a sampler with {dim}D sets \
-                             (umj, padded:xy=...,uv=..., or jitter, random, sobol, which draw {dim}D sets)"
+                            "{e}: {what} needs {draw_dim}D sets; use a sampler that draws them \
+                             (umj, padded:xy=...,uv=..., or jitter, random, sobol)"
                         )
                     }
                     e => e.into(),
@@ -211,12 +248,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     sampler,
                     seed,
                     sets: a.draw.sets(),
-                    dims: None,
+                    dims: plane.clone(),
                 };
                 (source, *requested, Some(seed))
             }
             Level::File(path) => {
-                let sets = varspec::io::read_point_sets_of_dim(path, dim)?;
+                let sets = if plane.is_some() {
+                    varspec::io::read_point_sets(path)?
+                } else {
+                    varspec::io::read_point_sets_of_dim(path, dim)?
+                };
                 if let Some(other) = sets.iter().find(|s| s.len() != sets[0].len()) {
                     bail!(
                         "{}: its sets hold {} and {} points; a level of the fit needs one N",
@@ -228,7 +269,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 let n = sets[0].len();
                 let source = Source::File {
                     sets,
-                    dims: None,
+                    dims: plane.clone(),
                     name: path.display().to_string(),
                 };
                 (source, n, None)
@@ -327,7 +368,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let theory = match (&subject, &a.sampler) {
         // The table's rates are for default parameters: `cmj --param m=4`
         // has none, as `cmj:m=4` has none; nor has a level on a thin grid.
-        (Subject::Torus(f), Some(sampler)) if a.draw.params.is_empty() && caveats == 0 => {
+        // Nor has a projection: the table is of the sets themselves.
+        (Subject::Torus(f), Some(sampler))
+            if a.draw.params.is_empty() && caveats == 0 && plane.is_none() =>
+        {
             theoretical_rate(sampler, f.class(), dim)
         }
         _ => None,
@@ -402,7 +446,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             });
         }
         let plot = LinePlot {
-            title: format!("{label} on {name}"),
+            title: match &a.dims {
+                Some(d) => format!("{label} (dims {d}) on {name}"),
+                None => format!("{label} on {name}"),
+            },
             x_label: "N".into(),
             y_label: "variance".into(),
             log_log: true,
@@ -420,7 +467,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             json!(points.iter().map(|p| p.sets).collect::<Vec<_>>())
         };
         let out = json!({
-            "sampler": a.sampler, "files": a.points.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(), "integrand": name,
+            "sampler": a.sampler, "files": a.points.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(), "integrand": name, "dims": plane,
             "method": match (&subject, method) {
                 (Subject::Square(_), _) => "square: unshifted estimator's MSE over the family (brute force)",
                 (_, MethodArg::Spatial) => "spatial",
@@ -483,7 +530,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         });
     let outside = fit.excludes(theory);
     let theory = theory.map_or(
-        "none (the table of known rates has no entry for this sampler and integrand)".into(),
+        if plane.is_some() {
+            "none (the table of known rates is of whole sets, not projections)".into()
+        } else {
+            "none (the table of known rates has no entry for this sampler and integrand)".into()
+        },
         |t| format!("{t}"),
     );
     outln!("slope {:.3}, 95% CI {ci}; theory {theory}", fit.slope);
