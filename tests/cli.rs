@@ -285,11 +285,11 @@ fn bad_requests_fail_with_a_specific_message() {
                 "--res",
                 "2",
             ],
-            "--res 2: the Fourier box |k| < K/2 needs K >= 3",
+            "`2`: the box |k| < K/2 needs a whole K >= 3",
         ),
         (
             vec!["spectrum", "--sampler", "jitter", "-n", "64", "--res", "2"],
-            "--res 2: the box |k| < K/2 needs K >= 3",
+            "`2`: the box |k| < K/2 needs a whole K >= 3",
         ),
         (
             vec![

@@ -163,7 +163,7 @@ fn bad_spectrum_requests_are_clear_errors() {
         ),
         (
             vec!["spectrum", s(&four), "--dims", "0,2", "--res", "1"],
-            "K >= 3",
+            "whole K >= 3",
         ),
         (vec!["spectrum", s(&broken)], "broken.csv:3:"),
         (vec!["pcf", s(&broken)], "broken.csv:3:"),

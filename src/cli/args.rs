@@ -230,6 +230,18 @@ pub fn whole<T: TryFrom<u64>>(text: &str) -> Result<T, String> {
     whole_at_least::<0, T>(text)
 }
 
+/// A Fourier box --res K: a whole number ≥ 3, the smallest box |k| < K/2
+/// that holds a frequency besides k = 0 (one message for 0 and for −4).
+pub fn frequency_box(text: &str) -> Result<usize, String> {
+    match parse_whole(text) {
+        Ok(k) if k >= 3 => usize::try_from(k).map_err(|_| format!("`{text}` is too large")),
+        Ok(_) | Err(NotWhole::Negative) => Err(format!(
+            "`{text}`: the box |k| < K/2 needs a whole K >= 3 to hold a frequency besides k = 0"
+        )),
+        Err(_) => whole::<usize>(text),
+    }
+}
+
 /// A whole number of at least `MIN`, as [`whole`].
 pub fn whole_at_least<const MIN: u64, T: TryFrom<u64>>(text: &str) -> Result<T, String> {
     let value = parse_whole(text).map_err(|e| match e {

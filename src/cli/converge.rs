@@ -73,7 +73,7 @@ pub struct Args {
     method: Option<MethodArg>,
     /// Fourier box |k| < K/2 for --method fourier or expected (default 256 in
     /// 2D, 21 in 4D; for expected in 2D, at least 8√N + 1 at each N).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
+    #[arg(value_parser = super::args::frequency_box, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// CSV of N against variance.
     #[arg(long)]
@@ -168,9 +168,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     // The label of the sets: the sampler, or "point files".
     let label = a.sampler.clone().unwrap_or_else(|| "point files".into());
-    if a.res.is_some_and(|r| r < 3) {
-        bail!("--res must be at least 3 (the box |k| < K/2 must hold a frequency besides 0)");
-    }
     let method = a.method.unwrap_or(if dim == 2 {
         MethodArg::Spatial
     } else {

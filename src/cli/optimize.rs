@@ -110,7 +110,7 @@ pub struct PointsArgs {
     /// Frequency box |k| < K/2 of the loss, as in spectrum and predict
     /// (default K = 2h + 1 with h = 2.5·N^(1/d) within [16, 400] for families
     /// and power laws, 8·N^(1/d) within [32, 256] for integrands).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
+    #[arg(value_parser = super::args::frequency_box, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// NUFFT tolerance of the loss and gradient (the speed/accuracy knob;
     /// default 1e-6, as the blue-noise sampler).

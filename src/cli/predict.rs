@@ -109,7 +109,7 @@ pub struct Args {
     shift: Option<ShiftArg>,
     /// Fourier box |k| < K/2 (default 256 in 2D, 21 in 4D: the box of
     /// converge and experiment).
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long)]
+    #[arg(value_parser = super::args::frequency_box, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// NUFFT tolerance of the Fourier predictor's spectrum [default: 1e-10].
     #[arg(long, value_parser = super::args::tolerance)]
@@ -186,11 +186,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     if a.realizations.is_some() && !(asks(MethodArg::Empirical) || asks(MethodArg::All)) {
         bail!("--realizations applies to the empirical predictor (--method empirical or all)");
-    }
-    if let Some(res) = a.res.filter(|&r| r < 3) {
-        bail!(
-            "--res {res}: the Fourier box |k| < K/2 needs K >= 3 (K = 3 is the 3^d box around DC)"
-        );
     }
     let mut source = a.source.resolve(Some(f.dim()))?;
     let sets = source.count();

@@ -37,7 +37,7 @@ pub struct Args {
     #[arg(long, conflicts_with_all = ["points", "points_flag", "sampler", "n", "sets_given", "params", "density", "method", "tol"])]
     integrand: Option<String>,
     /// Resolution K: the frequency box |k| < K/2 in each axis.
-    #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 128)]
+    #[arg(value_parser = super::args::frequency_box, allow_negative_numbers = true, long, default_value_t = 128)]
     res: usize,
     /// How S(k) is computed (default fast).
     #[arg(long, value_enum)]
@@ -99,12 +99,6 @@ fn integrand_power(
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
-    if a.res < 3 {
-        bail!(
-            "--res {}: the box |k| < K/2 needs K >= 3 to hold a frequency besides k = 0",
-            a.res
-        );
-    }
     let pixel_files = a
         .integrand
         .as_deref()
