@@ -113,7 +113,7 @@ fn draw_lines(plot: &LinePlot, buf: &mut [u8], size: (u32, u32)) -> std::io::Res
     root.fill(&WHITE).map_err(draw_error)?;
     let mut builder = ChartBuilder::on(&root);
     builder
-        .caption(&plot.title, ("sans-serif", 22))
+        .caption(&plot.title, ("sans-serif", title_size(&root, &plot.title)))
         .margin(16)
         .x_label_area_size(48)
         .y_label_area_size(80);
@@ -520,6 +520,23 @@ fn tick_number(v: f64) -> String {
 
 /// Draws axes, labels and colour-bar ticks; returns the pixel ranges of the
 /// heat map and the colour bar, which the caller fills.
+/// The largest title size up to 22 px whose text fits the picture's width
+/// (a long title, such as a scene figure's, was clipped at both ends).
+fn title_size<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+) -> f64 {
+    let room = area.dim_in_pixel().0.saturating_sub(24);
+    let mut size = 22.0;
+    while size > 11.0 {
+        match area.estimate_text_size(title, &("sans-serif", size).into_text_style(area)) {
+            Ok((w, _)) if w > room => size -= 1.0,
+            _ => break,
+        }
+    }
+    size
+}
+
 fn draw_heatmap_frame(
     map: &HeatMap,
     buf: &mut [u8],
@@ -528,7 +545,7 @@ fn draw_heatmap_frame(
     let root = BitMapBackend::with_buffer(buf, size).into_drawing_area();
     root.fill(&WHITE).map_err(draw_error)?;
     let root = root
-        .titled(&map.title, ("sans-serif", 22))
+        .titled(&map.title, ("sans-serif", title_size(&root, &map.title)))
         .map_err(draw_error)?;
     let (left, right) = root.split_horizontally(size.0 - 150);
     let (x0, x1) = map.x_range;
