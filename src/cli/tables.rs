@@ -34,8 +34,9 @@ pub struct Args {
     /// Sampler to draw the table from.
     #[arg(long)]
     sampler: Option<String>,
-    /// Point-set file to convert instead.
-    #[arg(long)]
+    /// Point-set file to convert instead (--points, as in the analysis
+    /// commands, is the same).
+    #[arg(long, visible_alias = "points", value_name = "FILE")]
     from: Option<PathBuf>,
     /// Points per set (with --sampler).
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
