@@ -93,6 +93,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.output.display()
         )
     })?;
+    let format = match format {
+        FormatArg::Csv => TableFormat::Csv,
+        FormatArg::Json => TableFormat::Json,
+        FormatArg::F32 => TableFormat::F32,
+        FormatArg::F64 => TableFormat::F64,
+        FormatArg::CHeader => TableFormat::CHeader,
+    };
+    // The metadata sidecar is an output too: `--from t.csv.json -o t.csv`
+    // overwrote its own input.
+    let sidecar = format.needs_sidecar().then(|| {
+        let mut path = a.output.clone().into_os_string();
+        path.push(".json");
+        PathBuf::from(path)
+    });
+    super::args::check_outputs_beside(
+        [Some(a.output.as_path()), sidecar.as_deref()],
+        [a.from.as_deref()],
+    )?;
     let mut run_params = a.draw.params.clone();
     let mut run_seed = a.draw.seed();
     let mut run_sampler = a.sampler.clone();
@@ -128,13 +146,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
         (None, None) => bail!("give --sampler or --from"),
     };
-    let format = match format {
-        FormatArg::Csv => TableFormat::Csv,
-        FormatArg::Json => TableFormat::Json,
-        FormatArg::F32 => TableFormat::F32,
-        FormatArg::F64 => TableFormat::F64,
-        FormatArg::CHeader => TableFormat::CHeader,
-    };
     let provenance = Provenance {
         optimized_for: optimized_for(run_sampler.as_deref(), &run_params)?,
         source,
@@ -156,10 +167,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "table".into());
     write_atomic(&a.output, |w| write_table(w, &sets, &meta, format, &name))?;
-    if format.needs_sidecar() {
-        let mut sidecar = a.output.clone().into_os_string();
-        sidecar.push(".json");
-        write_atomic(std::path::Path::new(&sidecar), |w| {
+    if let Some(sidecar) = &sidecar {
+        write_atomic(sidecar, |w| {
             w.write_all(
                 serde_json::to_string_pretty(&meta)
                     .map_err(std::io::Error::other)?
