@@ -499,3 +499,43 @@ fn the_format_follows_the_output_name() {
     );
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+/// The sidecar records the parameters the sampler was built with, in one
+/// place: `cmj:m=4 --param m=2` is cmj with m = 2 (the flag wins), and said
+/// `source: cmj:m=4, params: [m=2]` before (third trial).
+#[test]
+fn the_metadata_names_the_parameters_used() {
+    let dir = crate::common::temp_dir("tables-params");
+    let both = dir.join("both.csv");
+    let flag = dir.join("flag.csv");
+    crate::common::varspec_ok(&[
+        "tables",
+        "--sampler",
+        "cmj:m=4",
+        "-n",
+        "16",
+        "--param",
+        "m=2",
+        "--sets",
+        "1",
+        "-o",
+        both.to_str().unwrap(),
+    ]);
+    crate::common::varspec_ok(&[
+        "tables",
+        "--sampler",
+        "cmj",
+        "-n",
+        "16",
+        "--param",
+        "m=2",
+        "--sets",
+        "1",
+        "-o",
+        flag.to_str().unwrap(),
+    ]);
+    assert_eq!(std::fs::read(&both).unwrap(), std::fs::read(&flag).unwrap());
+    let meta = crate::common::read_json(&dir.join("both.csv.json"));
+    assert_eq!(meta["source"], "cmj", "{meta}");
+    assert_eq!(meta["params"], serde_json::json!([["m", "2"]]), "{meta}");
+}

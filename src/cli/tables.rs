@@ -128,11 +128,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             let n = a.n.context("--sampler needs -n")?;
             let s = registry::build(name, n, a.dim, &a.draw.params)?;
             super::args::note_caveat(s.as_ref());
+            // The metadata records the parameters the sampler was built
+            // with, in one place: the shorthand's and --param's (which win).
+            let (base, given) = registry::split_spec(name, &a.draw.params)?;
+            run_params = given
+                .iter()
+                .enumerate()
+                .filter(|(i, (k, _))| !given[i + 1..].iter().any(|(later, _)| later == k))
+                .map(|(_, kv)| kv.clone())
+                .collect();
+            run_sampler = Some(base.to_string());
             let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =
                 samplers::generate_sets(s.as_ref(), a.draw.seed(), a.draw.sets(), &|| bar.inc(1))?;
             bar.finish_and_clear();
-            (sets, name.clone())
+            (sets, base.to_string())
         }
         (None, Some(path)) => {
             a.draw.refuse_with_file(path, false)?;
