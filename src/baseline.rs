@@ -43,7 +43,7 @@ where
     let mut out = Vec::new();
     for name in CLASSIC {
         if let Ok((sampler, n)) = registry::build_nearest(name, n, Some(dim), &[]) {
-            let sets = generate_sets(sampler.as_ref(), seed ^ 0x5eed, realizations, &|| {})?;
+            let sets = generate_sets(sampler.as_ref(), seed ^ 0x5eed, realizations, &|_| {})?;
             out.push(Baseline {
                 name,
                 n,

@@ -1204,6 +1204,62 @@ fn a_full_standard_output_is_an_error_and_no_file_appears() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[cfg(target_os = "linux")]
+#[test]
+fn a_failed_write_is_never_announced_as_written() {
+    // `sample -o /dev/full` printed "wrote /dev/full: …" and then the
+    // error: device bytes are written when the command's outputs are made
+    // visible, after the lines (third new-user trial).
+    let dir = temp_dir("never-announced");
+    let beside = dir.join("beside.csv");
+    let out = varspec(&["sample", "random", "-n", "4", "-o", "/dev/full"]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("cannot write /dev/full: No space left on device"),
+        "{stderr}"
+    );
+    assert!(!stdout.contains("wrote"), "announced: {stdout}");
+    // With a file beside the device, neither is announced and the file
+    // does not appear.
+    let out = varspec(&[
+        "spectrum",
+        "--sampler",
+        "jitter",
+        "-n",
+        "64",
+        "--csv",
+        beside.to_str().unwrap(),
+        "--png",
+        "/dev/full",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(!stdout.contains("wrote"), "announced: {stdout}");
+    assert!(
+        !beside.exists(),
+        "the file beside the failed device appeared"
+    );
+    // A write that succeeds is announced.
+    let out = varspec(&[
+        "sample",
+        "random",
+        "-n",
+        "4",
+        "-o",
+        beside.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && stdout.contains(&format!("wrote {}", beside.display())),
+        "{stdout}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A CSV file's header and records, read by the csv crate.
 fn csv_table(path: &std::path::Path) -> (Vec<String>, Vec<csv::StringRecord>) {
     let mut r = csv::Reader::from_path(path).unwrap();

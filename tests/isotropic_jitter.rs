@@ -23,7 +23,7 @@ fn mean_sd_se(values: &[f64]) -> (f64, f64, f64) {
 }
 
 fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Vec<PointSet> {
-    samplers::generate_sets(sampler, seed, sets, &|| {}).unwrap()
+    samplers::generate_sets(sampler, seed, sets, &|_| {}).unwrap()
 }
 
 #[test]

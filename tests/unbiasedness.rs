@@ -32,7 +32,7 @@ fn coordinate_means_are_one_half_within_their_confidence_interval() {
             (2000, vec![])
         };
         let (sampler, n) = registry::build_nearest(name, 64, Some(d), &params).unwrap();
-        let realizations = samplers::generate_sets(sampler.as_ref(), 2024, sets, &|| {}).unwrap();
+        let realizations = samplers::generate_sets(sampler.as_ref(), 2024, sets, &|_| {}).unwrap();
         for j in 0..d {
             // Per-set mean of coordinate j, then their mean and standard error.
             let means: Vec<f64> = realizations

@@ -179,7 +179,7 @@ fn samplers(a: SamplersArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, rows.iter()))?;
-    outln!("wrote {}", a.csv.display());
+    announce!("wrote {}", a.csv.display());
     Ok(())
 }
 
@@ -319,7 +319,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
-    outln!("wrote {}", a.csv.display());
+    announce!("wrote {}", a.csv.display());
     Ok(())
 }
 
@@ -433,7 +433,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
         });
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, &out))?;
-    outln!("wrote {}", a.csv.display());
+    announce!("wrote {}", a.csv.display());
     Ok(())
 }
 
@@ -652,7 +652,7 @@ fn spectrum(a: SpectrumArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
-    outln!("wrote {}", a.csv.display());
+    announce!("wrote {}", a.csv.display());
     Ok(())
 }
 
@@ -720,7 +720,7 @@ fn predict(a: PredictArgs) -> anyhow::Result<()> {
         }
     }
     write_atomic(&a.csv, |w| write_csv_rows(w, &rows))?;
-    outln!("wrote {}", a.csv.display());
+    announce!("wrote {}", a.csv.display());
     Ok(())
 }
 

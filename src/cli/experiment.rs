@@ -84,7 +84,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             })?;
             bar.finish_and_clear();
             super::stdout::bytes(md.as_bytes());
-            outln!("wrote {}", out.display());
+            announce!("wrote {}", out.display());
             return Ok(());
         }
     };
@@ -107,12 +107,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         };
         let json = serde_json::to_string_pretty(&shard_file)?;
         write_atomic(&out.join(&name), |w| w.write_all(json.as_bytes()))?;
-        outln!("wrote {}", out.join(name).display());
+        announce!("wrote {}", out.join(name).display());
         return Ok(());
     }
     let md = write_results(&e, &file, &cells, &out)?;
     super::stdout::bytes(md.as_bytes());
-    outln!("wrote {}", out.display());
+    announce!("wrote {}", out.display());
     Ok(())
 }
 

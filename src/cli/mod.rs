@@ -107,12 +107,19 @@ pub fn main() -> ExitCode {
     let cli = Cli::from_arg_matches(&grammar().get_matches()).unwrap_or_else(|e| e.exit());
     // A command's outputs appear together or not at all; a standard
     // output that failed (not merely closed: see `stdout`) fails it.
+    let stdout_failed = || match stdout::finish() {
+        Some(e) => Err(anyhow::anyhow!("cannot write to standard output: {e}")),
+        None => Ok(()),
+    };
     let result = varspec::io::all_or_nothing(|| {
         run(cli.command)?;
-        match stdout::finish() {
-            Some(e) => Err(anyhow::anyhow!("cannot write to standard output: {e}")),
-            None => Ok(()),
-        }
+        stdout_failed()?;
+        // "wrote …" only once the writes that can still fail have
+        // succeeded (a device such as /dev/full fails when written; the
+        // renames that remain do not run out of space).
+        varspec::io::write_staged_devices()?;
+        stdout::release_announcements();
+        stdout_failed()
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -598,7 +598,7 @@ fn sheared_outputs(
     sampler: &dyn varspec::samplers::Sampler,
     transform: impl Fn(&varspec::PointSet) -> anyhow::Result<varspec::PointSet>,
 ) -> anyhow::Result<()> {
-    let sets = varspec::samplers::generate_sets(sampler, a.seed, a.sets, &|| {})?;
+    let sets = varspec::samplers::generate_sets(sampler, a.seed, a.sets, &|_| {})?;
     let sheared: Vec<_> = sets.iter().map(transform).collect::<Result<_, _>>()?;
     if let Some(path) = &a.output {
         varspec::io::write_point_file(path, &sheared)?;

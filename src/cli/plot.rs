@@ -57,7 +57,7 @@ fn points(a: PointsArgs) -> anyhow::Result<()> {
     let img = render_points(set, [dims[0], dims[1]], a.size)
         .with_context(|| format!("{}", a.file.display()))?;
     save_png(&img, &a.output)?;
-    outln!(
+    announce!(
         "wrote {}: set {} of {}, dimensions {} and {}",
         a.output.display(),
         a.set,

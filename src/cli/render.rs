@@ -349,7 +349,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .flatten()
         .map(|p| p.display().to_string())
         .collect();
-    outln!("wrote {}", written.join(", "));
+    announce!("wrote {}", written.join(", "));
     Ok(())
 }
 

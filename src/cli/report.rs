@@ -49,7 +49,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .iter()
         .find(|r| r.best)
         .map_or("?", |r| r.sampler.as_str());
-    outln!(
+    announce!(
         "wrote {} in {:.1} s: lowest variance on {} at N = {}: {best}; square design {:.2}x CMJ on half-planes; \
          shear ({:.3}, {:.3}) for c = {:.2}, {:.1}x lower",
         a.output.join("index.html").display(),

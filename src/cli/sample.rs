@@ -90,7 +90,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let sampler = registry::build(&name, n, a.dim, &a.params)?;
     args::note_caveat(sampler.as_ref());
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
-    let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|| bar.inc(1))?;
+    let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|_| bar.inc(1))?;
     bar.finish_and_clear();
     if let Some(density) = sampler.density() {
         // The files hold points only: the weight 1/λ has to be given back.
@@ -104,7 +104,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         Some(path) => {
             write_atomic(path, |w| format.write(w, &sets))?;
             let dim = sets.first().map_or(0, |s| s.dim());
-            outln!(
+            announce!(
                 "wrote {}: {} of {name} N={n} in {dim}D",
                 path.display(),
                 super::stdout::counted(sets.len(), "set")

@@ -22,6 +22,11 @@ enum State {
 
 static STATE: Mutex<State> = Mutex::new(State::Open);
 
+/// Lines that announce written files ("wrote …"), held back until the
+/// command's outputs have been made visible (`io::all_or_nothing`): an
+/// output whose final write fails (`-o /dev/full`) must not be announced.
+static ANNOUNCEMENTS: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
 /// Set when an output file is standard output (`-o /dev/stdout`): the
 /// command's lines then go to standard error, so the file's bytes reach
 /// the reader alone.
@@ -65,8 +70,30 @@ fn write(put: impl FnOnce(&mut io::StdoutLock) -> io::Result<()>) {
     }
 }
 
+/// Holds `args` as a line to print once the command's outputs are
+/// visible (see [`ANNOUNCEMENTS`]).
+pub fn announce(args: fmt::Arguments) {
+    ANNOUNCEMENTS
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .push(args.to_string());
+}
+
+/// Prints the held announcements, in the order they were made: call it
+/// after the outputs have been made visible.
+pub fn release_announcements() {
+    let held = std::mem::take(
+        &mut *ANNOUNCEMENTS
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner),
+    );
+    for text in held {
+        line(format_args!("{text}"));
+    }
+}
+
 /// Flushes standard output and returns the failure a write met, if any
-/// (a closed reader is none).
+/// (a closed reader is none); the failure is returned once.
 pub fn finish() -> Option<io::Error> {
     let mut state = STATE
         .lock()
@@ -77,9 +104,15 @@ pub fn finish() -> Option<io::Error> {
     {
         return Some(e);
     }
-    match std::mem::replace(&mut *state, State::Closed) {
-        State::Failed(e) => Some(e),
-        _ => None,
+    match std::mem::replace(&mut *state, State::Open) {
+        State::Failed(e) => {
+            *state = State::Closed;
+            Some(e)
+        }
+        other => {
+            *state = other;
+            None
+        }
     }
 }
 
@@ -93,15 +126,23 @@ macro_rules! outln {
     };
 }
 
+/// [`announce`] with `format!` arguments: a line about written files,
+/// printed once they are visible.
+macro_rules! announce {
+    ($($arg:tt)*) => {
+        $crate::cli::stdout::announce(format_args!($($arg)*))
+    };
+}
+
 /// "wrote A, B": the files a command wrote, in one line (nothing when
-/// there are none).
+/// there are none), announced once they are visible.
 pub fn wrote<P: AsRef<std::path::Path>>(paths: impl IntoIterator<Item = P>) {
     let names: Vec<String> = paths
         .into_iter()
         .map(|p| p.as_ref().display().to_string())
         .collect();
     if !names.is_empty() {
-        line(format_args!("wrote {}", names.join(", ")));
+        announce(format_args!("wrote {}", names.join(", ")));
     }
 }
 

@@ -140,7 +140,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             run_sampler = Some(base.to_string());
             let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =
-                samplers::generate_sets(s.as_ref(), a.draw.seed(), a.draw.sets(), &|| bar.inc(1))?;
+                samplers::generate_sets(s.as_ref(), a.draw.seed(), a.draw.sets(), &|_| bar.inc(1))?;
             bar.finish_and_clear();
             (sets, base.to_string())
         }
@@ -186,7 +186,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             )
         })?;
     }
-    outln!(
+    announce!(
         "wrote {} ({} of {} points in {}D)",
         a.output.display(),
         super::stdout::counted(sets.len(), "set"),
@@ -224,7 +224,7 @@ fn draw_table_shard(a: &Args, shard: Shard) -> anyhow::Result<()> {
     let path = shard_path(&a.output, shard);
     let json = serde_json::to_string(&part)?;
     write_atomic(&path, |w| w.write_all(json.as_bytes()))?;
-    outln!(
+    announce!(
         "wrote {} ({mine} of {} sets)",
         path.display(),
         part.run.sets

@@ -190,7 +190,7 @@ pub fn run_items(
             // Realizations drawn once per item and shared by every integrand.
             // Each N its own stream, so the levels of a slope are independent.
             let seed = crate::rng::level_seed(e.seed, n);
-            let sets = samplers::generate_sets(s.as_ref(), seed, e.sets, &|| {})
+            let sets = samplers::generate_sets(s.as_ref(), seed, e.sets, &|_| {})
                 .map_err(|err| fail("-", err.to_string()))?;
             for (fi, f) in functions.iter().enumerate() {
                 let p = sampler_variance(f.as_ref(), e.sets, VarianceForm::Auto, |r| {

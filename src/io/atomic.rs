@@ -78,21 +78,9 @@ pub fn all_or_nothing<T, E: From<WriteError>>(work: impl FnOnce() -> Result<T, E
             return Err(e);
         }
     };
-    for item in &staged {
-        if let Staged::InPlace {
-            path,
-            target,
-            bytes,
-        } = item
-            && let Err(cause) = write_in_place(target, |w| w.write_all(bytes))
-        {
-            discard(&staged);
-            return Err(WriteError {
-                path: path.clone(),
-                cause,
-            }
-            .into());
-        }
+    if let Err(e) = write_devices(&staged) {
+        discard(&staged);
+        return Err(e.into());
     }
     for (i, item) in staged.iter().enumerate() {
         if let Staged::Rename { path, tmp, target } = item
@@ -107,6 +95,48 @@ pub fn all_or_nothing<T, E: From<WriteError>>(work: impl FnOnce() -> Result<T, E
         }
     }
     Ok(value)
+}
+
+/// Writes the device bytes staged so far in the active [`all_or_nothing`]
+/// group now, in order, and forgets them: the writes that can still fail
+/// at the end (a full device), done before what the caller does next
+/// (announcing the outputs). The renamed files still wait for the group.
+///
+/// # Errors
+/// The [`WriteError`] of the first device that failed; the group then
+/// fails when its work returns the error.
+pub fn write_staged_devices() -> Result<(), WriteError> {
+    let devices: Vec<Staged> = STAGED.with(|s| {
+        let mut s = s.borrow_mut();
+        let Some(list) = s.as_mut() else {
+            return Vec::new();
+        };
+        let (devices, files) = std::mem::take(list)
+            .into_iter()
+            .partition(|item| matches!(item, Staged::InPlace { .. }));
+        *list = files;
+        devices
+    });
+    write_devices(&devices)
+}
+
+/// Writes the [`Staged::InPlace`] items of `staged` in order.
+fn write_devices(staged: &[Staged]) -> Result<(), WriteError> {
+    for item in staged {
+        if let Staged::InPlace {
+            path,
+            target,
+            bytes,
+        } = item
+            && let Err(cause) = write_in_place(target, |w| w.write_all(bytes))
+        {
+            return Err(WriteError {
+                path: path.clone(),
+                cause,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// [`write_atomic`] made visible at once even inside [`all_or_nothing`]:

@@ -11,7 +11,7 @@ pub mod tables;
 
 pub use atomic::{
     WriteError, all_or_nothing, check_output, file_identity, is_standard_output, read_output,
-    write_atomic, write_atomic_now,
+    write_atomic, write_atomic_now, write_staged_devices,
 };
 pub use bounded::{read_bounded, read_text_bounded};
 pub use csv_rows::write_csv_rows;

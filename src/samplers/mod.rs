@@ -256,7 +256,8 @@ pub fn sets_bytes(sampler: &dyn Sampler, sets: usize) -> f64 {
 
 /// Draws `sets` realizations of `sampler` in parallel; realization r uses
 /// the stream [`set_rng`]`(seed, r)`. `on_set_done` is called once per
-/// finished set (for progress display).
+/// finished set with the time that set took to draw on its thread (for
+/// progress display and per-set timings).
 ///
 /// # Errors
 /// [`SamplerError::Memory`] before anything is drawn when the sets would
@@ -266,7 +267,7 @@ pub fn generate_sets(
     sampler: &dyn Sampler,
     seed: u64,
     sets: usize,
-    on_set_done: &(dyn Fn() + Sync),
+    on_set_done: &(dyn Fn(std::time::Duration) + Sync),
 ) -> Result<Vec<PointSet>, SamplerError> {
     crate::memory::check(
         &format!(
@@ -280,8 +281,9 @@ pub fn generate_sets(
     (0..sets as u64)
         .into_par_iter()
         .map(|r| {
+            let start = std::time::Instant::now();
             let set = sampler.sample(&mut set_rng(seed, r));
-            on_set_done();
+            on_set_done(start.elapsed());
             set
         })
         .collect()

@@ -335,7 +335,7 @@ impl TourOptions {
 }
 
 fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Result<Vec<PointSet>, TourError> {
-    crate::samplers::generate_sets(sampler, seed, sets, &|| {}).map_err(at("drawing sets"))
+    crate::samplers::generate_sets(sampler, seed, sets, &|_| {}).map_err(at("drawing sets"))
 }
 
 /// Runs the tour, writing its pictures into `options.folder`;

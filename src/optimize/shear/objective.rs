@@ -773,5 +773,5 @@ fn draw(sampler: &dyn Sampler, seed: u64, count: usize) -> Result<Vec<PointSet>,
         Some(sets_bytes(sampler, count)),
         "lower -n",
     )?;
-    Ok(generate_sets(sampler, seed, count, &|| {})?)
+    Ok(generate_sets(sampler, seed, count, &|_| {})?)
 }
