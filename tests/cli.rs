@@ -637,7 +637,9 @@ fn the_main_job_writes_a_self_contained_report() {
         .args([
             "report",
             "-n",
-            "64",
+            // Not a square: jitter needs 64, and every row is compared
+            // there (random ran at 63 beside jitter at 64: third trial).
+            "63",
             "--sets",
             "4",
             "-o",
@@ -685,6 +687,14 @@ fn the_main_job_writes_a_self_contained_report() {
         "{stdout} vs {ratio:.2}"
     );
     let rows = report["predict"]["rows"].as_array().unwrap();
+    assert!(
+        rows.iter().all(|r| r["n"] == 64) && report["predict"]["n"] == 64,
+        "rows at other N than jitter's 64: {rows:?}"
+    );
+    assert!(
+        html.contains("the nearest N to the requested 63 that jitter allows"),
+        "the page does not say N moved"
+    );
     // The three predictors agree: spatial, and Fourier up to its
     // truncation bound, within the empirical 95% CI for jitter.
     let jitter = &rows[1];
@@ -762,6 +772,32 @@ fn the_main_job_writes_a_self_contained_report() {
         square["brute_force"]["mse"].as_f64(),
         "the square section's design vs its printed commands"
     );
+    // Section 5's commands write the two spectra its 1e-6 row compares
+    // (it printed `bench spectrum`, which measures other sets: third
+    // trial).
+    let prefix = "varspec spectrum --sampler jitter -n 1024 --sets 8 --seed 0 --res 129";
+    run_printed("speed", &format!("{prefix} --method direct"), false);
+    run_printed("speed", &format!("{prefix} --tol 1e-6"), false);
+    let column = |file: &str| -> Vec<f64> {
+        let mut r = csv::Reader::from_path(dir.join(file)).unwrap();
+        r.records()
+            .map(|x| x.unwrap()[2].parse().unwrap())
+            .collect()
+    };
+    let (exact, fast) = (column("exact.csv"), column("fast.csv"));
+    assert_eq!(exact.len(), 129 * 129);
+    let max_error = exact
+        .iter()
+        .zip(&fast)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let row = report["speed"]["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["method"] == "NUFFT, tolerance 1e-6")
+        .expect("a 1e-6 row");
+    assert_eq!(row["max_error"].as_f64(), Some(max_error), "{row}");
     let scene = &report["scene"];
     assert!(scene["reduction"].as_f64().unwrap() > 1.5, "{scene}");
     assert!(

@@ -494,7 +494,7 @@ fn the_format_follows_the_output_name() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        !out.status.success() && err.contains("does not name one (.csv, .json, .h)"),
+        !out.status.success() && err.contains("does not name one (.csv, .json, .h, .hpp)"),
         "{err}"
     );
     std::fs::remove_dir_all(&d).unwrap();
@@ -538,4 +538,40 @@ fn the_metadata_names_the_parameters_used() {
     let meta = crate::common::read_json(&dir.join("both.csv.json"));
     assert_eq!(meta["source"], "cmj", "{meta}");
     assert_eq!(meta["params"], serde_json::json!([["m", "2"]]), "{meta}");
+}
+
+/// docs/formats.md shows a C header with the command that writes it: the
+/// example's lines up to the first point are the command's output (the
+/// predicted variances in the docs had gone stale by the 10th digit:
+/// third new-user trial).
+#[test]
+fn the_documented_c_header_is_what_the_command_writes() {
+    let docs = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/formats.md"))
+        .expect("docs/formats.md");
+    let command =
+        "varspec tables --sampler cmj -n 256 --sets 64 --param m=16 --format c-header -o cmj256.h";
+    assert!(
+        docs.contains(command),
+        "the docs no longer show `{command}`"
+    );
+    let example = docs
+        .split("```c\n")
+        .nth(1)
+        .and_then(|block| block.split("\n```").next())
+        .expect("a ```c block in docs/formats.md");
+    let d = dir("documented");
+    let out = d.join("cmj256.h");
+    let mut args: Vec<&str> = command.split(' ').skip(1).collect();
+    *args.last_mut().unwrap() = out.to_str().unwrap();
+    varspec(&args);
+    let written = std::fs::read_to_string(&out).unwrap();
+    // The example's lines up to and including the first point; the rest
+    // is elided with "…".
+    let shown: Vec<&str> = example.lines().take_while(|l| !l.contains('…')).collect();
+    let actual: Vec<&str> = written.lines().take(shown.len()).collect();
+    assert_eq!(
+        shown, actual,
+        "docs/formats.md's C header example differs from the output"
+    );
+    std::fs::remove_dir_all(&d).unwrap();
 }

@@ -280,8 +280,6 @@ pub fn count(text: &str) -> Result<usize, String> {
     }
 }
 
-/// Prints a sampler's caveat ([`varspec::samplers::Sampler::caveat`]) as a
-/// note on standard error; whether it had one.
 /// A Fourier form's truncation bound above this fraction of its value is
 /// named (predict, converge).
 pub const LOOSE_TRUNCATION: f64 = 0.1;
@@ -292,6 +290,8 @@ pub const NOT_WHITE_BEYOND_THE_BOX: &str = "beyond the Fourier box the spectrum 
      (an axis-aligned edge against N-rooks strata, a lattice's dual points, a spectrum still \
      rising)";
 
+/// Prints a sampler's caveat ([`varspec::samplers::Sampler::caveat`]) as a
+/// note on standard error; whether it had one.
 pub fn note_caveat(sampler: &dyn varspec::samplers::Sampler) -> bool {
     let caveat = sampler.caveat();
     if let Some(c) = &caveat {

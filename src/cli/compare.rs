@@ -101,8 +101,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .with_context(|| format!("cannot create folder {}", a.output.display()))?;
     let bar = progress::bar(COMPARED.len() as u64, "sampling");
     let mut rows = Vec::new();
+    let mut caveats = Vec::new();
     for name in COMPARED {
         let (sampler, n) = registry::build_nearest(name, a.n, Some(2), &[])?;
+        caveats.extend(sampler.caveat());
         let times = Mutex::new(Vec::with_capacity(a.sets));
         let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|t| {
             times.lock().unwrap_or_else(PoisonError::into_inner).push(t);
@@ -172,6 +174,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         "nn_min / nn_mean: minimum and mean nearest-neighbour distance over the hexagonal packing distance \
          sqrt(2/(sqrt(3) N)) (Lagae & Dutre 2008; 1 = densest packing, random ~ 0.01 / 0.5)."
     );
+    // After the table: the progress bar no longer shares the terminal.
+    for c in caveats {
+        eprintln!("note: {c}");
+    }
     let csv = a.output.join("summary.csv");
     #[derive(serde::Serialize)]
     struct Summary<'a> {

@@ -88,7 +88,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let format = a.format.or(named).with_context(|| {
         format!(
-            "--format is needed: {} does not name one (.csv, .json, .h); f32 and f64 are \
+            "--format is needed: {} does not name one (.csv, .json, .h, .hpp); f32 and f64 are \
              raw floats, named with --format",
             a.output.display()
         )
