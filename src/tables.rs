@@ -175,6 +175,18 @@ pub fn metadata(
         TableFormat::F32 | TableFormat::CHeader => "f32 (float), little-endian where raw",
         _ => "f64",
     };
+    let predicted_variance_skipped = match status {
+        PredictedVariances::Computed => None,
+        PredictedVariances::NotTwoD => Some(format!(
+            "the reference integrands are 2D and the sets are {dim}D"
+        )),
+        PredictedVariances::OverBudget { pairs } => Some(format!(
+            "{pairs:.3e} pair evaluations ({} integrands x N^2 x {} sets) exceed 2^28; \
+             `tables --variance` computes them",
+            REFERENCE_INTEGRANDS.len(),
+            sets.len()
+        )),
+    };
     let meta = TableMetadata {
         generator: format!("varspec {}", env!("CARGO_PKG_VERSION")),
         source: provenance.source,
@@ -186,6 +198,7 @@ pub fn metadata(
         layout: format!("[set][point][dimension], {value_type}, values in [0, 1)"),
         optimized_for: provenance.optimized_for,
         predicted_variance,
+        predicted_variance_skipped,
     };
     Ok((meta, status))
 }

@@ -1296,6 +1296,24 @@ fn a_failed_write_is_never_announced_as_written() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[test]
+fn a_benchmark_refuses_its_csv_path_before_measuring() {
+    // `bench samplers --csv DIR` ran the whole benchmark, printed its table
+    // and only then failed to write (third new-user trial).
+    let dir = temp_dir("bench-folder");
+    let out = varspec(&["bench", "samplers", "--csv", dir.to_str().unwrap()]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(
+        !out.status.success() && stderr.contains("it is a folder"),
+        "{stderr}"
+    );
+    assert!(stdout.is_empty(), "measured before refusing: {stdout}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A CSV file's header and records, read by the csv crate.
 fn csv_table(path: &std::path::Path) -> (Vec<String>, Vec<csv::StringRecord>) {
     let mut r = csv::Reader::from_path(path).unwrap();

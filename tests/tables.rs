@@ -186,6 +186,7 @@ fn f32_tables_stay_below_one() {
         layout: String::new(),
         optimized_for: "none".into(),
         predicted_variance: vec![],
+        predicted_variance_skipped: None,
     };
     let mut bytes = Vec::new();
     write_table(&mut bytes, &[set], &meta, TableFormat::F32, "t").unwrap();
@@ -244,11 +245,24 @@ fn costly_predicted_variances_are_opt_in() {
         args.extend_from_slice(extra);
         args.extend(["-o", path.to_str().unwrap()]);
         let err = varspec(&args);
-        (sidecar(&path).predicted_variance.len(), err)
+        let meta = sidecar(&path);
+        (
+            meta.predicted_variance.len(),
+            err,
+            meta.predicted_variance_skipped,
+        )
     };
-    let (count, err) = table("large.csv", "5000", "4", &[]);
+    let (count, err, skipped) = table("large.csv", "5000", "4", &[]);
     assert!(err.contains("pass --variance"), "{err}");
     assert_eq!(count, 0);
+    // The file says why the list is empty (it said nothing: third trial).
+    assert!(
+        skipped
+            .as_deref()
+            .is_some_and(|why| why.contains("exceed 2^28") && why.contains("tables --variance")),
+        "{skipped:?}"
+    );
+    assert_eq!(table("small.csv", "64", "2", &[]).2, None);
     assert_eq!(table("small.csv", "64", "2", &[]).0, 4);
     assert_eq!(table("forced.csv", "5000", "1", &["--variance"]).0, 4);
     let _ = std::fs::remove_dir_all(&d);

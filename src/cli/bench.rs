@@ -86,14 +86,15 @@ pub struct SpectrumArgs {
     quick: bool,
 }
 
-/// Creates the folder of a benchmark's CSV before the (long) run, so a bad
-/// path fails at once rather than after the measurements.
+/// Creates the folder of a benchmark's CSV and checks the CSV can be
+/// written there before the (long) run, so a bad path (a folder, a
+/// read-only place) fails at once rather than after the measurements.
 fn prepare(csv: &std::path::Path) -> anyhow::Result<()> {
     if let Some(dir) = csv.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
             .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
     }
-    Ok(())
+    super::args::check_outputs([Some(csv)])
 }
 
 pub fn run(c: BenchCommand) -> anyhow::Result<()> {

@@ -63,6 +63,10 @@ pub struct TableMetadata {
     /// Predicted variance (shift-randomized estimator, spatial form, mean
     /// over the table's sets) on reference integrands.
     pub predicted_variance: Vec<(String, f64)>,
+    /// Why `predicted_variance` is empty, when it is (sets that are not
+    /// 2D, or a cost over the budget); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub predicted_variance_skipped: Option<String>,
 }
 
 /// The largest f32 below 1.
@@ -265,6 +269,9 @@ fn write_c_header(
     }
     for (spec, v) in &meta.predicted_variance {
         writeln!(out, " * predicted variance on {spec}: {v:e}")?;
+    }
+    if let Some(why) = &meta.predicted_variance_skipped {
+        writeln!(out, " * no predicted variances: {why}")?;
     }
     writeln!(
         out,
