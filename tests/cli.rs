@@ -1314,6 +1314,42 @@ fn a_benchmark_refuses_its_csv_path_before_measuring() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+#[test]
+fn long_work_off_a_terminal_logs_its_progress() {
+    // A progress bar is drawn only on a terminal; a batch job's log said
+    // nothing for hours (third new-user trial). Off a terminal a line comes
+    // every VARSPEC_PROGRESS_SECONDS (default 60; this run takes ~3 s on 2
+    // cores, so at 1 s it logs and by default it does not).
+    let dir = temp_dir("progress-log");
+    let out = dir.join("bn.csv");
+    let run = |every: Option<&str>| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_varspec"));
+        c.args(["sample", "blue-noise", "-n", "1024", "--sets", "8", "-o"])
+            .arg(&out)
+            .env_remove("VARSPEC_PROGRESS_SECONDS");
+        if let Some(every) = every {
+            c.env("VARSPEC_PROGRESS_SECONDS", every);
+        }
+        let o = c.output().unwrap();
+        assert!(o.status.success());
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let logged = run(Some("1"));
+    assert!(
+        logged.contains("varspec: blue-noise N=1024: ") && logged.contains(" of 8 after "),
+        "{logged}"
+    );
+    assert!(
+        !run(None).contains("varspec: blue-noise"),
+        "logged before a minute"
+    );
+    assert!(
+        !run(Some("0")).contains("varspec: blue-noise"),
+        "0 turns it off"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A CSV file's header and records, read by the csv crate.
 fn csv_table(path: &std::path::Path) -> (Vec<String>, Vec<csv::StringRecord>) {
     let mut r = csv::Reader::from_path(path).unwrap();

@@ -1,15 +1,45 @@
-//! Progress bars: drawn on a terminal's stderr, absent when stderr is not a
-//! terminal (pipes, CI logs).
+//! Progress bars: drawn on a terminal's stderr. Off a terminal (pipes, CI
+//! logs, batch jobs) long work still reports: a line on stderr every
+//! [`LOG_EVERY`] while it runs, so a job's log says how far it got and how
+//! long is left.
 
 use std::io::IsTerminal;
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-/// A bar over `len` steps labelled `what`; hidden off a terminal or for
-/// work too small to watch.
+/// Interval of the progress lines written off a terminal (the first after
+/// this long: work that ends sooner writes none), unless
+/// `VARSPEC_PROGRESS_SECONDS` sets another (0: no lines).
+const LOG_EVERY: Duration = Duration::from_secs(60);
+
+/// The interval of the progress lines off a terminal: `LOG_EVERY`, or
+/// `VARSPEC_PROGRESS_SECONDS` when it holds whole seconds (`None` for 0).
+fn log_every() -> Option<Duration> {
+    match std::env::var("VARSPEC_PROGRESS_SECONDS")
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+    {
+        Some(0) => None,
+        Some(seconds) => Some(Duration::from_secs(seconds)),
+        None => Some(LOG_EVERY),
+    }
+}
+
+/// A bar over `len` steps labelled `what`; off a terminal, a hidden bar
+/// whose progress is logged (see the module docs); hidden for work too
+/// small to watch.
 pub fn bar(len: u64, what: &str) -> ProgressBar {
-    if !std::io::stderr().is_terminal() || len < 2 {
+    if len < 2 {
         return ProgressBar::hidden();
+    }
+    if !std::io::stderr().is_terminal() {
+        let bar = ProgressBar::hidden();
+        bar.set_length(len);
+        if let Some(every) = log_every() {
+            log_while_running(&bar, what.to_string(), every);
+        }
+        return bar;
     }
     let bar = ProgressBar::new(len);
     bar.set_style(
@@ -34,4 +64,52 @@ pub fn spinner(what: &str) -> ProgressBar {
     spinner.set_message(what.to_string());
     spinner.enable_steady_tick(std::time::Duration::from_millis(200));
     spinner
+}
+
+/// Writes "varspec: WHAT: pos of len after …, about … left" on stderr
+/// `every` so long until `bar` is finished or dropped, from a thread of
+/// its own that holds only a weak reference.
+fn log_while_running(bar: &ProgressBar, what: String, every: Duration) {
+    let weak = bar.downgrade();
+    let started = Instant::now();
+    std::thread::spawn(move || {
+        let mut next = every;
+        loop {
+            std::thread::sleep(every.min(Duration::from_secs(1)));
+            let Some(bar) = weak.upgrade() else { return };
+            if bar.is_finished() {
+                return;
+            }
+            let elapsed = started.elapsed();
+            if elapsed < next {
+                continue;
+            }
+            next += every;
+            let (pos, len) = (bar.position(), bar.length().unwrap_or(0));
+            let left = if pos > 0 && len > pos {
+                format!(
+                    ", about {} left",
+                    duration_words(elapsed.mul_f64((len - pos) as f64 / pos as f64))
+                )
+            } else {
+                String::new()
+            };
+            eprintln!(
+                "varspec: {what}: {pos} of {len} after {}{left}",
+                duration_words(elapsed)
+            );
+        }
+    });
+}
+
+/// "2 h 05 min", "3 min 20 s", "45 s".
+pub fn duration_words(d: Duration) -> String {
+    let s = d.as_secs();
+    if s >= 3600 {
+        format!("{} h {:02} min", s / 3600, s % 3600 / 60)
+    } else if s >= 60 {
+        format!("{} min {:02} s", s / 60, s % 60)
+    } else {
+        format!("{s} s")
+    }
 }

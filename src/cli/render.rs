@@ -432,7 +432,7 @@ fn warn_slow_sets(sampler: &dyn Sampler, name: &str, seed: u64, sets: usize) -> 
             } else {
                 format!("{:.2} ms", one * 1e3)
             },
-            hours_minutes(total)
+            super::progress::duration_words(std::time::Duration::from_secs_f64(total))
         );
     }
     Ok(())
@@ -440,13 +440,3 @@ fn warn_slow_sets(sampler: &dyn Sampler, name: &str, seed: u64, sets: usize) -> 
 
 /// Seconds of set drawing above which [`warn_slow_sets`] speaks.
 const SLOW_DRAWING: f64 = 30.0;
-
-/// `total` seconds as "N h M min" or "M min".
-fn hours_minutes(total: f64) -> String {
-    let minutes = (total / 60.0).round();
-    if minutes >= 60.0 {
-        format!("{} h {} min", (minutes / 60.0).floor(), minutes % 60.0)
-    } else {
-        format!("{} min", minutes.max(1.0))
-    }
-}

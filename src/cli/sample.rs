@@ -89,6 +89,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     args::check_outputs([a.output.as_deref()])?;
     let sampler = registry::build(&name, n, a.dim, &a.params)?;
     args::note_caveat(sampler.as_ref());
+    let format = Format::resolve(a.format, a.output.as_deref());
+    note_large_output(format, sampler.points_per_set(), sampler.dim(), a.sets);
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
     let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|_| bar.inc(1))?;
     bar.finish_and_clear();
@@ -99,7 +101,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
              analyse the sets with --density {density} so the estimator weighs points by 1/{density}"
         );
     }
-    let format = Format::resolve(a.format, a.output.as_deref());
     match &a.output {
         Some(path) => {
             write_atomic(path, |w| format.write(w, &sets))?;
@@ -119,6 +120,31 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Output size above which [`note_large_output`] speaks (1 GB).
+const LARGE_OUTPUT: f64 = 1e9;
+
+/// A note before drawing when the output will be large: its estimated size
+/// (text: ~20 characters per coordinate; npy: 8 bytes), so a request for
+/// 10⁹ points is seen for what it is before the disk fills.
+fn note_large_output(format: Format, n: usize, dim: usize, sets: usize) {
+    let values = n as f64 * dim as f64 * sets as f64;
+    let bytes = match format {
+        Format::Npy => 8.0 * values,
+        Format::Csv | Format::Utk => 20.0 * values,
+    };
+    if bytes > LARGE_OUTPUT {
+        eprintln!(
+            "note: the output will be about {:.0} GB ({values:.1e} coordinates{})",
+            bytes / 1e9,
+            if matches!(format, Format::Npy) {
+                ""
+            } else {
+                "; as .npy it would be 8 bytes each"
+            }
+        );
+    }
 }
 
 fn list() -> anyhow::Result<()> {

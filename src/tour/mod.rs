@@ -326,6 +326,29 @@ impl TourOptions {
                 f.dim()
             )));
         }
+        // Section 1's exact spatial form is O(N²) per set (the pairs
+        // within the autocovariance's support when it is small).
+        let within = f
+            .autocov_support()
+            .filter(|&r| r < 0.25)
+            .map_or(1.0, |r| (std::f64::consts::PI * r * r).min(1.0));
+        let pairs =
+            SECTION_ONE_SAMPLERS as f64 * self.sets as f64 * (self.n as f64).powi(2) * within;
+        if pairs > REPORT_PAIRS {
+            return Err(at("the sampler comparison (-n, --sets)")(format!(
+                "-n {} with --sets {} costs {pairs:.1e} pair evaluations of the exact spatial \
+                 form ({SECTION_ONE_SAMPLERS} samplers x sets x N^2{}), over the report's \
+                 {REPORT_PAIRS:.1e} (~6 min at the 1e8 per second measured on 2 cores); lower -n \
+                 or --sets (predict --method expected handles a large N alone)",
+                self.n,
+                self.sets,
+                if within < 1.0 {
+                    " x the autocovariance's support"
+                } else {
+                    ""
+                }
+            )));
+        }
         let pixel = integrands::parse(&self.pixel).map_err(at("the pixel (--pixel)"))?;
         if pixel.light_field().is_none() {
             return Err(at("the pixel (--pixel)")(format!(
@@ -336,6 +359,14 @@ impl TourOptions {
         Ok(())
     }
 }
+
+/// Samplers in section 1's table.
+const SECTION_ONE_SAMPLERS: usize = 6;
+
+/// Pair evaluations of section 1's spatial form a report may cost (2^35:
+/// about 6 minutes at the ~1e8 per second measured on 2 cores; -n 16384
+/// with 16 sets fits).
+const REPORT_PAIRS: f64 = 34_359_738_368.0;
 
 fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Result<Vec<PointSet>, TourError> {
     crate::samplers::generate_sets(sampler, seed, sets, &|_| {}).map_err(at("drawing sets"))
@@ -375,7 +406,7 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
     let f = integrands::parse(&o.integrand).map_err(at("the integrand"))?;
     let half = 127;
     let realizations = 4000;
-    let names = [
+    let names: [&str; SECTION_ONE_SAMPLERS] = [
         "random",
         "jitter",
         "cmj",
