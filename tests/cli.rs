@@ -572,6 +572,31 @@ fn plot_draws_a_projection_and_reports_bad_files_by_line() {
         png.to_str().unwrap(),
     ]);
     assert!(String::from_utf8_lossy(&bad_dims.stderr).contains("out of range"));
+    // A 1D set is a strip of ticks (it was refused: third trial): at 64
+    // pixels, the points 0.25 and 0.75 ink exactly the column pairs their
+    // centres 15.5 and 47.5 straddle.
+    let line = dir.join("line.csv");
+    std::fs::write(&line, "x0\n0.25\n0.75\n").unwrap();
+    let out = varspec(&[
+        "plot",
+        "points",
+        line.to_str().unwrap(),
+        "--size",
+        "64",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let strip = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(strip.dimensions(), (64, 16));
+    let inked: Vec<u32> = (1..63)
+        .filter(|&x| strip.get_pixel(x, 8).0 != [255, 255, 255])
+        .collect();
+    assert_eq!(inked, [15, 16, 47, 48]);
     let broken = dir.join("broken.csv");
     std::fs::write(&broken, "x0,x1\n0.5,0.5\n0.5,1.5\n").unwrap();
     let out = varspec(&[

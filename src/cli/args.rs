@@ -17,7 +17,11 @@ pub fn dims(text: &str, count: usize) -> anyhow::Result<Vec<usize>> {
         .map(|t| t.trim().parse::<usize>())
         .collect::<Result<Vec<_>, _>>()
         .with_context(|| {
-            format!("--dims `{text}`: expected {count} comma-separated indices such as 0,2")
+            if count == 1 {
+                format!("--dims `{text}`: expected an index such as 0")
+            } else {
+                format!("--dims `{text}`: expected {count} comma-separated indices such as 0,2")
+            }
         })?;
     if dims.len() != count {
         bail!(

@@ -59,6 +59,46 @@ pub fn render_points(
     Ok(img)
 }
 
+/// Draws a 1D set (or dimension `dim` of any set) as a strip `size` wide
+/// and `size`/8 high (at least 16): each point a vertical tick at its
+/// coordinate, anti-aliased across its pixel column, so gaps and clumps
+/// read along the line.
+///
+/// # Errors
+/// [`PointSetError::Projection`] for a `dim` out of range.
+pub fn render_points_1d(set: &PointSet, dim: usize, size: u32) -> Result<RgbImage, PointSetError> {
+    let proj = set.projected(&[dim])?;
+    let height = (size / 8).max(16);
+    let mut img = RgbImage::from_pixel(size, height, BACKGROUND);
+    for x in 0..size {
+        img.put_pixel(x, 0, FRAME);
+        img.put_pixel(x, height - 1, FRAME);
+    }
+    for y in 0..height {
+        img.put_pixel(0, y, FRAME);
+        img.put_pixel(size - 1, y, FRAME);
+    }
+    let margin = height / 4;
+    for p in proj.points() {
+        // The tick's centre at p·size: split its ink between the two
+        // pixel columns it straddles.
+        let centre = p[0] * size as f64 - 0.5;
+        let left = centre.floor();
+        for (column, cover) in [(left, 1.0 - (centre - left)), (left + 1.0, centre - left)] {
+            if column < 0.0 || column >= size as f64 || cover <= 0.0 {
+                continue;
+            }
+            for y in margin..height - margin {
+                let px = img.get_pixel_mut(column as u32, y);
+                for (c, ink) in px.0.iter_mut().zip(INK) {
+                    *c = (*c as f64 * (1.0 - cover) + ink * cover).round() as u8;
+                }
+            }
+        }
+    }
+    Ok(img)
+}
+
 /// Writes `img` to `path` as PNG, atomically.
 ///
 /// # Errors
