@@ -30,6 +30,7 @@ enum FormatArg {
 
 #[derive(clap::Args)]
 #[command(group = clap::ArgGroup::new("table_source").required(true).args(["sampler", "from", "merge"]))]
+#[command(mut_arg("sets_given", |a| a.help("Sets in the table (with --sampler; default 16)")))]
 pub struct Args {
     /// Sampler to draw the table from.
     #[arg(long)]
