@@ -197,12 +197,35 @@ pub fn run(a: Args) -> anyhow::Result<()> {
              --integrand has no members"
         );
     }
-    let bar = progress::bar(levels.len() as u64, "converge");
+    // Each level's share of the work: the spatial form's pair evaluations
+    // (O(N²) per set), else N; a file's N is not known before it is read.
+    let spatial_on = match (&subject, method) {
+        (Subject::Torus(f), MethodArg::Spatial) => Some(f.as_ref()),
+        _ => None,
+    };
+    let sets = a.draw.sets();
+    let weights: Vec<u64> = levels
+        .iter()
+        .map(|level| match (level, spatial_on) {
+            (Level::Sampler(n), Some(f)) => {
+                (sets as f64 * varspec::variance::pair_evaluations(f, *n)).max(1.0) as u64
+            }
+            (Level::Sampler(n), None) => *n as u64,
+            (Level::File(_), _) => 1,
+        })
+        .collect();
+    if let Some(f) = spatial_on
+        && a.points.is_empty()
+    {
+        let runs: Vec<(usize, usize)> = a.ns.iter().map(|&n| (n, sets)).collect();
+        progress::note_spatial_cost(f, &runs);
+    }
+    let bar = progress::share_bar(weights.iter().sum(), "converge");
     let mut points = Vec::new();
     // Levels whose sampler is not what its name promises (a thin
     // multi-jittered grid): the table's rate is not theirs.
     let mut caveats = 0;
-    for level in &levels {
+    for (level, &weight) in levels.iter().zip(&weights) {
         let (source, requested, seed) = match level {
             Level::Sampler(requested) => {
                 let sampler_name = a.sampler.as_deref().unwrap_or_default();
@@ -356,7 +379,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             truncation_bound,
             seed,
         });
-        bar.inc(1);
+        bar.inc(weight);
     }
     bar.finish_and_clear();
     let ns: Vec<f64> = points.iter().map(|p| p.n as f64).collect();

@@ -566,6 +566,8 @@ fn set_forms(
         }
     }
     if wants(MethodArg::Spatial) {
+        let n = drawn.iter().map(PointSet::len).max().unwrap_or(0);
+        progress::note_spatial_cost(f, &[(n, sets)]);
         let start = Instant::now();
         let bar = progress::bar(sets as u64, "spatial form, sets");
         // The spatial form takes its sets in order: set r starts when r are done.

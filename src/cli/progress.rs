@@ -30,6 +30,26 @@ fn log_every() -> Option<Duration> {
 /// whose progress is logged (see the module docs); hidden for work too
 /// small to watch.
 pub fn bar(len: u64, what: &str) -> ProgressBar {
+    counted_bar(len, what, Shown::Steps)
+}
+
+/// [`bar`] over work measured in units of unequal steps (pair evaluations,
+/// points): it shows the percentage done, and its time left follows the
+/// work rather than the step count.
+pub fn share_bar(work: u64, what: &str) -> ProgressBar {
+    counted_bar(work, what, Shown::Percent)
+}
+
+/// How a bar's progress reads.
+#[derive(Clone, Copy)]
+enum Shown {
+    /// "3/16".
+    Steps,
+    /// "42%".
+    Percent,
+}
+
+fn counted_bar(len: u64, what: &str, shown: Shown) -> ProgressBar {
     if len < 2 {
         return ProgressBar::hidden();
     }
@@ -37,13 +57,17 @@ pub fn bar(len: u64, what: &str) -> ProgressBar {
         let bar = ProgressBar::hidden();
         bar.set_length(len);
         if let Some(every) = log_every() {
-            log_while_running(&bar, what.to_string(), every);
+            log_while_running(&bar, what.to_string(), every, shown);
         }
         return bar;
     }
     let bar = ProgressBar::new(len);
+    let template = match shown {
+        Shown::Steps => "{msg} [{bar:40}] {pos}/{len} ({eta} left)",
+        Shown::Percent => "{msg} [{bar:40}] {percent}% ({eta} left)",
+    };
     bar.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta} left)")
+        ProgressStyle::with_template(template)
             .expect("static template")
             .progress_chars("=> "),
     );
@@ -66,10 +90,10 @@ pub fn spinner(what: &str) -> ProgressBar {
     spinner
 }
 
-/// Writes "varspec: WHAT: pos of len after …, about … left" on stderr
+/// Writes "varspec: WHAT: pos of len (or P% done) after …, about … left" on stderr
 /// `every` so long until `bar` is finished or dropped, from a thread of
 /// its own that holds only a weak reference.
-fn log_while_running(bar: &ProgressBar, what: String, every: Duration) {
+fn log_while_running(bar: &ProgressBar, what: String, every: Duration, shown: Shown) {
     let weak = bar.downgrade();
     let started = Instant::now();
     std::thread::spawn(move || {
@@ -86,7 +110,9 @@ fn log_while_running(bar: &ProgressBar, what: String, every: Duration) {
             }
             next += every;
             let (pos, len) = (bar.position(), bar.length().unwrap_or(0));
-            let left = if pos > 0 && len > pos {
+            // Under 1% done the extrapolation says nothing (a tiny first
+            // level finished, the large one running): no time left then.
+            let left = if pos > 0 && len > pos && pos as f64 >= 0.01 * len as f64 {
                 format!(
                     ", about {} left",
                     duration_words(elapsed.mul_f64((len - pos) as f64 / pos as f64))
@@ -94,22 +120,55 @@ fn log_while_running(bar: &ProgressBar, what: String, every: Duration) {
             } else {
                 String::new()
             };
+            let done = match shown {
+                Shown::Steps => format!("{pos} of {len}"),
+                Shown::Percent => format!("{:.0}% done", 100.0 * pos as f64 / len.max(1) as f64),
+            };
             eprintln!(
-                "varspec: {what}: {pos} of {len} after {}{left}",
+                "varspec: {what}: {done} after {}{left}",
                 duration_words(elapsed)
             );
         }
     });
 }
 
-/// "2 h 05 min", "3 min 20 s", "45 s".
+/// "5.5 days", "2 h 05 min", "3 min 20 s", "45 s".
 pub fn duration_words(d: Duration) -> String {
     let s = d.as_secs();
-    if s >= 3600 {
+    if s >= 48 * 3600 {
+        format!("{:.1} days", s as f64 / 86400.0)
+    } else if s >= 3600 {
         format!("{} h {:02} min", s / 3600, s % 3600 / 60)
     } else if s >= 60 {
         format!("{} min {:02} s", s / 60, s % 60)
     } else {
         format!("{s} s")
+    }
+}
+
+/// Estimated seconds of work above which a command says so before it
+/// starts.
+const LONG_WORK: f64 = 60.0;
+
+/// Before the spatial form runs on `runs` (N, sets): a note when it would
+/// take over a minute here, with the pair evaluations and the time
+/// ([`varspec::variance::estimated_seconds`]), since its cost is O(N²) per
+/// set and nothing else warns of a run that takes days.
+pub fn note_spatial_cost(f: &dyn varspec::integrands::Integrand, runs: &[(usize, usize)]) {
+    let mut seconds = 0.0;
+    let mut pairs = 0.0;
+    for &(n, sets) in runs {
+        let Ok(s) = varspec::variance::estimated_seconds(f, n, sets) else {
+            return;
+        };
+        seconds += s;
+        pairs += sets as f64 * varspec::variance::pair_evaluations(f, n);
+    }
+    if seconds > LONG_WORK {
+        eprintln!(
+            "note: the spatial form is O(N^2) per set: {pairs:.1e} pair evaluations, about {} \
+             here; the fourier (or expected) form costs O(N log N)",
+            duration_words(Duration::from_secs_f64(seconds))
+        );
     }
 }

@@ -326,27 +326,20 @@ impl TourOptions {
                 f.dim()
             )));
         }
-        // Section 1's exact spatial form is O(N²) per set (the pairs
-        // within the autocovariance's support when it is small).
-        let within = f
-            .autocov_support()
-            .filter(|&r| r < 0.25)
-            .map_or(1.0, |r| (std::f64::consts::PI * r * r).min(1.0));
-        let pairs =
-            SECTION_ONE_SAMPLERS as f64 * self.sets as f64 * (self.n as f64).powi(2) * within;
+        // Section 1's exact spatial form is O(N²) per set.
+        let pairs = SECTION_ONE_SAMPLERS as f64
+            * self.sets as f64
+            * crate::variance::pair_evaluations(f.as_ref(), self.n);
         if pairs > REPORT_PAIRS {
+            let hours = crate::variance::estimated_seconds(f.as_ref(), self.n, self.sets)
+                .map_or(f64::NAN, |s| s * SECTION_ONE_SAMPLERS as f64 / 3600.0);
             return Err(at("the sampler comparison (-n, --sets)")(format!(
                 "-n {} with --sets {} costs {pairs:.1e} pair evaluations of the exact spatial \
-                 form ({SECTION_ONE_SAMPLERS} samplers x sets x N^2{}), over the report's \
-                 {REPORT_PAIRS:.1e} (~6 min at the 1e8 per second measured on 2 cores); lower -n \
-                 or --sets (predict --method expected handles a large N alone)",
-                self.n,
-                self.sets,
-                if within < 1.0 {
-                    " x the autocovariance's support"
-                } else {
-                    ""
-                }
+                 form ({SECTION_ONE_SAMPLERS} samplers x sets x N(N-1)/2, within the \
+                 autocovariance's support), about {hours:.0} h here, over the report's \
+                 {REPORT_PAIRS:.1e}; lower -n or --sets (predict --method expected handles a \
+                 large N alone)",
+                self.n, self.sets,
             )));
         }
         let pixel = integrands::parse(&self.pixel).map_err(at("the pixel (--pixel)"))?;
@@ -363,10 +356,10 @@ impl TourOptions {
 /// Samplers in section 1's table.
 const SECTION_ONE_SAMPLERS: usize = 6;
 
-/// Pair evaluations of section 1's spatial form a report may cost (2^35:
-/// about 6 minutes at the ~1e8 per second measured on 2 cores; -n 16384
-/// with 16 sets fits).
-const REPORT_PAIRS: f64 = 34_359_738_368.0;
+/// Pair evaluations of section 1's spatial form a report may cost (2^34;
+/// -n 16384 with 16 sets fits: 1.3e10, about 13 minutes on the default
+/// disk on 2 cores).
+const REPORT_PAIRS: f64 = 17_179_869_184.0;
 
 fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Result<Vec<PointSet>, TourError> {
     crate::samplers::generate_sets(sampler, seed, sets, &|_| {}).map_err(at("drawing sets"))

@@ -140,6 +140,14 @@ where
             got: realizations,
         });
     }
+    // The estimates are kept (8 bytes each), collected through rayon's
+    // per-thread lists and copied once more for the interval: 24 bytes an
+    // ample bound.
+    crate::memory::check(
+        &format!("the estimates of {realizations} realizations"),
+        Some(realizations as f64 * 24.0),
+        "lower --realizations",
+    )?;
     let d = f.dim();
     let values: Vec<f64> = (0..realizations)
         .into_par_iter()

@@ -33,7 +33,9 @@ pub use radial::{RadialEstimate, radial_from};
 pub use sets::{
     MAX_AUTO_SETS, SetCount, TARGET_RELATIVE_STDERR, auto_set_cap, sets_for_relative_stderr,
 };
-pub use spatial::{SpatialEstimate, spatial, spatial_variance};
+pub use spatial::{
+    SpatialEstimate, estimated_seconds, pair_evaluations, spatial, spatial_variance,
+};
 
 use crate::samplers::SamplerError;
 use crate::spectrum::SpectrumError;
@@ -121,6 +123,9 @@ pub enum VarianceError {
     /// The spectrum could not be computed.
     #[error(transparent)]
     Spectrum(#[from] SpectrumError),
+    /// The results would not fit in memory.
+    #[error(transparent)]
+    Memory(#[from] crate::memory::TooMuchMemory),
 }
 
 fn density_text(d: Option<f64>) -> String {

@@ -27,6 +27,58 @@ use crate::sum::NeumaierSum;
 /// the thread count).
 const ROWS: usize = 32;
 
+/// The autocovariance support radius below which [`spatial_variance`]
+/// visits only close pairs (with more than [`GRID_MIN_POINTS`] points).
+const GRID_MAX_SUPPORT: f64 = 0.25;
+
+/// Points above which a small support is worth the cell grid.
+const GRID_MIN_POINTS: usize = 64;
+
+/// The support radius [`spatial_variance`] restricts its pairs to, if any.
+fn grid_support(f: &dyn Integrand, n: usize) -> Option<f64> {
+    f.autocov_support()
+        .filter(|&r| r < GRID_MAX_SUPPORT && n > GRID_MIN_POINTS)
+}
+
+/// Pair evaluations [`spatial_variance`] makes on one set of `n` points:
+/// the n(n−1)/2 distinct pairs, or the expected number within the
+/// autocovariance's support (a ball of its radius on the unit torus) when
+/// only close pairs are visited.
+pub fn pair_evaluations(f: &dyn Integrand, n: usize) -> f64 {
+    let pairs = n as f64 * (n as f64 - 1.0) / 2.0;
+    let Some(r) = grid_support(f, n) else {
+        return pairs;
+    };
+    let pi = std::f64::consts::PI;
+    let ball = match f.dim() {
+        1 => 2.0 * r,
+        2 => pi * r * r,
+        3 => 4.0 / 3.0 * pi * r.powi(3),
+        _ => pi * pi / 2.0 * r.powi(4),
+    };
+    pairs * ball.min(1.0)
+}
+
+/// Seconds [`spatial`] would take here on `sets` sets of `n` points of
+/// `f`'s dimension: one set of min(n, 2048) random points is timed and the
+/// time scaled by [`pair_evaluations`] (the cost is O(N²) per set, so a
+/// request can run for days; commands say so before they start).
+///
+/// # Errors
+/// As [`spatial_variance`] (an integrand without c_f).
+pub fn estimated_seconds(f: &dyn Integrand, n: usize, sets: usize) -> Result<f64, VarianceError> {
+    let probe = n.clamp(2, 2048);
+    let mut rng = crate::rng::set_rng(0, 0);
+    let coords = (0..probe * f.dim())
+        .map(|_| crate::rng::uniform(&mut rng))
+        .collect();
+    let set = PointSet::new(f.dim(), coords).expect("uniform values lie in [0, 1)");
+    let start = std::time::Instant::now();
+    spatial_variance(&set, f)?;
+    let probe_seconds = start.elapsed().as_secs_f64();
+    Ok(probe_seconds * sets as f64 * pair_evaluations(f, n) / pair_evaluations(f, probe).max(1.0))
+}
+
 /// The spatial prediction, averaged over realizations.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpatialEstimate {
@@ -77,7 +129,7 @@ pub fn spatial_variance(points: &PointSet, f: &dyn Integrand) -> Result<(f64, f6
         }
         f.autocov(&h[..d]).expect("checked above")
     };
-    let support = f.autocov_support().filter(|&r| r < 0.25 && n > 64);
+    let support = grid_support(f, n);
     let off_diagonal = match support {
         Some(radius) => {
             // Close pairs exactly; each of the remaining pairs adds exactly −I².
@@ -183,4 +235,23 @@ where
         stderr,
         sets,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pair_evaluations;
+    use crate::integrands;
+
+    #[test]
+    fn pair_evaluations_count_the_pairs_the_form_visits() {
+        // Support 0.6 (disk r = 0.3): every distinct pair.
+        let wide = integrands::parse("disk:r=0.3").unwrap();
+        assert_eq!(pair_evaluations(wide.as_ref(), 1000), 499_500.0);
+        // Support 0.2 (< 0.25): the pairs within a disk of radius 0.2.
+        let small = integrands::parse("disk:r=0.1").unwrap();
+        let expected = 499_500.0 * std::f64::consts::PI * 0.04;
+        assert!((pair_evaluations(small.as_ref(), 1000) - expected).abs() < 1e-6 * expected);
+        // 64 points or fewer: no cell grid, every pair.
+        assert_eq!(pair_evaluations(small.as_ref(), 64), 2016.0);
+    }
 }
