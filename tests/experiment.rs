@@ -1135,7 +1135,7 @@ fn a_merge_refuses_shards_whose_cells_do_not_match_their_items() {
         serde_json::from_str(&std::fs::read_to_string(runs.join(name)).unwrap()).unwrap()
     };
     type Tamper = fn(&mut serde_json::Value);
-    let cases: [(&str, Tamper, &str); 4] = [
+    let cases: [(&str, Tamper, &str); 6] = [
         (
             "missing",
             |s| {
@@ -1160,6 +1160,18 @@ fn a_merge_refuses_shards_whose_cells_do_not_match_their_items() {
             "relabelled",
             |s| s["cells"][0]["sampler"] = serde_json::json!("sobol"),
             "is labelled `sobol`",
+        ),
+        // A hand edit of the N used was merged as if it had run, with a
+        // seed recomputed from it (fourth trial).
+        (
+            "edited N",
+            |s| s["cells"][0]["n"] = serde_json::json!(17),
+            "says N = 17, but that sampler runs at N = 16",
+        ),
+        (
+            "edited method",
+            |s| s["cells"][0]["method"] = serde_json::json!("fourier"),
+            "says method `fourier`, but a run uses `spatial` there",
         ),
     ];
     for (name, tamper, phrase) in cases {

@@ -383,8 +383,37 @@ fn check_shard_cells(e: &Experiment, canonical: &[String], s: &ShardFile) -> Res
             ));
         }
     }
-    match expected.into_iter().next() {
-        Some(key) => Err(format!("misses the cell of {}", describe(key))),
-        None => Ok(()),
+    if let Some(key) = expected.into_iter().next() {
+        return Err(format!("misses the cell of {}", describe(key)));
     }
+    // What a run computes from the experiment alone: the N each sampler
+    // uses (the seed follows from it) and the form each integrand takes.
+    // A hand-edited shard (n: 256 -> 257) was merged as if it had run.
+    for c in &s.cells {
+        let key = (c.sampler_index, c.n_index, c.integrand_index);
+        let (_, n) = registry::build_nearest(&c.sampler, c.requested, Some(e.dim()), &[])
+            .map_err(|err| format!("the cell of {}: {err}", describe(key)))?;
+        if c.n != n {
+            return Err(format!(
+                "the cell of {} says N = {}, but that sampler runs at N = {n}: the shard was \
+                 edited or written by another version",
+                describe(key),
+                c.n
+            ));
+        }
+        let f = integrands::parse(&c.integrand).map_err(|err| err.to_string())?;
+        let method = if f.autocov(&vec![0.0; f.dim()]).is_some() {
+            "spatial"
+        } else {
+            "fourier"
+        };
+        if c.method != method {
+            return Err(format!(
+                "the cell of {} says method `{}`, but a run uses `{method}` there",
+                describe(key),
+                c.method
+            ));
+        }
+    }
+    Ok(())
 }
