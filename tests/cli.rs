@@ -1431,6 +1431,89 @@ fn the_spatial_forms_cost_is_told_before_it_runs() {
     assert!(out.status.success() && !err.contains("O(N^2)"), "{err}");
 }
 
+#[test]
+fn a_variance_zero_to_rounding_is_printed_as_such() {
+    // A Gaussian integrated to machine precision by uniform jitter printed
+    // 2.710505e-20 as a value, and a note to raise --res (fourth trial).
+    let out = varspec(&[
+        "predict",
+        "--sampler",
+        "uniform-jitter",
+        "-n",
+        "256",
+        "--integrand",
+        "gaussian",
+        "--method",
+        "expected,spatial",
+    ]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(out.status.success(), "{stderr}");
+    for key in ["expected", "spatial"] {
+        assert!(
+            stdout
+                .lines()
+                .any(|l| l.trim_start().starts_with(key) && l.contains("0 to rounding")),
+            "{key}: {stdout}"
+        );
+    }
+    assert!(!stderr.contains("raise --res"), "{stderr}");
+}
+
+/// docs/formats.md's predict JSON example is what the command prints: the
+/// same keys, the same values (times aside; the Fourier form's sums to
+/// 1e-9 relative, as the docs allow). Its `expected` part had gone stale
+/// (res 256, no axis_strips, another variance: fourth trial).
+#[test]
+fn the_documented_predict_json_is_what_the_command_prints() {
+    let docs =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/formats.md")).unwrap();
+    let section = docs.split("### predict JSON").nth(1).expect("the section");
+    let example = section
+        .split("```json\n")
+        .nth(1)
+        .and_then(|b| b.split("\n```").next())
+        .expect("a json block");
+    let shown: serde_json::Value = serde_json::from_str(example).expect("the example parses");
+    let command = "varspec predict --sampler jitter -n 1024 --integrand disk:r=0.3 --json";
+    assert!(
+        section.contains(command),
+        "the docs no longer show `{command}`"
+    );
+    let args: Vec<&str> = command.split(' ').skip(1).collect();
+    let out = varspec(&args);
+    assert!(out.status.success());
+    let printed: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    fn same(path: &str, a: &serde_json::Value, b: &serde_json::Value) {
+        use serde_json::Value::{Number, Object};
+        match (a, b) {
+            (Object(x), Object(y)) => {
+                let (kx, ky): (Vec<_>, Vec<_>) = (x.keys().collect(), y.keys().collect());
+                assert_eq!(kx, ky, "{path}: keys of the docs vs the output");
+                for (k, v) in x {
+                    same(&format!("{path}.{k}"), v, &y[k]);
+                }
+            }
+            (Number(x), Number(y)) => {
+                if path.ends_with(".seconds") {
+                    return;
+                }
+                let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+                let fourier = path.starts_with(".fourier") || path.starts_with(".radial");
+                let tolerance = if fourier { 1e-9 * y.abs() } else { 0.0 };
+                assert!(
+                    (x - y).abs() <= tolerance,
+                    "{path}: docs {x:e}, output {y:e}"
+                );
+            }
+            _ => assert_eq!(a, b, "{path}"),
+        }
+    }
+    same("", &shown, &printed);
+}
+
 /// A CSV file's header and records, read by the csv crate.
 fn csv_table(path: &std::path::Path) -> (Vec<String>, Vec<csv::StringRecord>) {
     let mut r = csv::Reader::from_path(path).unwrap();

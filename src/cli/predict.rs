@@ -420,14 +420,32 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ("radial", "anisotropy_bound"),
     ] {
         if let Some(v) = out.get(key) {
-            let variance = v["variance"]
-                .as_f64()
-                .map_or("n/a".to_string(), |x| format!("{x:.6e}"));
+            // A value at or below its rounding bound is zero to rounding
+            // (the integrand is integrated to machine precision), as
+            // converge and the experiment tables say.
+            let rounding = v["variance"].as_f64().zip(v["rounding_bound"].as_f64());
+            let zero = rounding.is_some_and(|(x, b)| varspec::variance::zero_to_rounding(x, b));
+            let variance = match v["variance"].as_f64() {
+                _ if zero => "0 to rounding".to_string(),
+                Some(x) => format!("{x:.6e}"),
+                None => "n/a".to_string(),
+            };
             let note = match key {
                 "empirical" => match v["ci_high"].as_f64() {
                     Some(high) => format!(
-                        "95% CI [{:.4e}, {high:.4e}]",
-                        v["ci_low"].as_f64().unwrap_or(0.0)
+                        "95% CI [{:.4e}, {high:.4e}] over {} realizations{}",
+                        v["ci_low"].as_f64().unwrap_or(0.0),
+                        v["realizations"].as_u64().unwrap_or(0),
+                        // The default count was capped at the file's sets.
+                        if shift == ShiftArg::None
+                            && a.realizations.is_none()
+                            && a.source.file().is_some()
+                            && realizations < DEFAULT_REALIZATIONS
+                        {
+                            " (one per set of the file: unshifted, a set gives one estimate)"
+                        } else {
+                            ""
+                        }
                     ),
                     None => "every realization gave the same estimate, so the interval has no upper end (the variance is 0 if the integrand is constant; otherwise raise --realizations)".to_string(),
                 },
@@ -451,6 +469,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         "{extra} unknown (one set: draw 2 or more with --sets, or give a file of 2 or more sets)"
                     ),
                 },
+            };
+            let note = match rounding {
+                Some((x, b)) if zero => {
+                    format!("({x:.4e} <= its rounding bound {b:.2e})  {note}")
+                }
+                _ => note,
             };
             outln!("  {key:<10} {variance:>14}  {note}");
         }
@@ -494,8 +518,10 @@ fn note_loose_bounds(out: &serde_json::Map<String, Value>) {
         ),
     ] {
         let Some(v) = out.get(key) else { continue };
+        let rounding = v["rounding_bound"].as_f64().unwrap_or(0.0);
         if let (Some(value), Some(b)) = (v["variance"].as_f64(), v[bound].as_f64())
             && value > 0.0
+            && !varspec::variance::zero_to_rounding(value, rounding)
             && b > loose * value
         {
             eprintln!(

@@ -38,8 +38,8 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
         summary: "indicator of a disk (periodic images): F = r J1(2πr|k|)/|k| e^(−2πik·c)",
         params: &[
             ("r", "0.3", "radius in (0, 0.5]"),
-            ("cx", "0.5", "centre x"),
-            ("cy", "0.5", "centre y"),
+            ("cx", "0.5", "centre x, in [-1, 2] (wraps on the torus)"),
+            ("cy", "0.5", "centre y, in [-1, 2]"),
         ],
     },
     IntegrandInfo {
@@ -53,9 +53,13 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
                 "side along the first axis (cos θ, sin θ), in (0, 1]",
             ),
             ("h", "0.25", "side along the second axis, in (0, 1]"),
-            ("cx", "0.5", "centre x"),
-            ("cy", "0.5", "centre y"),
-            ("angle", "0", "θ in degrees, counter-clockwise"),
+            ("cx", "0.5", "centre x, in [-1, 2] (wraps on the torus)"),
+            ("cy", "0.5", "centre y, in [-1, 2]"),
+            (
+                "angle",
+                "0",
+                "θ in degrees, counter-clockwise, in [-360, 360]",
+            ),
         ],
     },
     IntegrandInfo {
@@ -73,9 +77,13 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
                 "sx",
                 "standard deviation along the second axis, in (0, 0.5]",
             ),
-            ("angle", "0", "θ in degrees, counter-clockwise"),
-            ("cx", "0.5", "centre x"),
-            ("cy", "0.5", "centre y"),
+            (
+                "angle",
+                "0",
+                "θ in degrees, counter-clockwise, in [-360, 360]",
+            ),
+            ("cx", "0.5", "centre x, in [-1, 2] (wraps on the torus)"),
+            ("cy", "0.5", "centre y, in [-1, 2]"),
         ],
     },
     IntegrandInfo {
@@ -83,8 +91,12 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
         dim: 2,
         summary: "indicator of {x in the unit square: (x − p)·n ≥ 0}, n = (cos θ, sin θ), p = (½,½) + offset·n",
         params: &[
-            ("angle", "0", "θ in degrees"),
-            ("offset", "0", "signed distance of the edge from the centre"),
+            ("angle", "0", "θ in degrees, in [-360, 360]"),
+            (
+                "offset",
+                "0",
+                "signed distance of the edge from the centre, in [-1, 1]",
+            ),
         ],
     },
     IntegrandInfo {
@@ -98,7 +110,7 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
                 "g: box (side size), disk (diameter size) or gaussian (4σ = size), centred at (½,½)",
             ),
             ("size", "0.3", "see shape, in [1e-4, 1]"),
-            ("c", "0", "shear c = (F − d)/d"),
+            ("c", "0", "shear c = (F − d)/d, in [-16, 16]"),
         ],
     },
     IntegrandInfo {
@@ -108,8 +120,12 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
         params: &[
             ("shape", "box", "g: box, disk or gaussian, as for defocus"),
             ("size", "0.3", "see defocus, in [1e-4, 1]"),
-            ("c1", "0.5", "shear of the first layer"),
-            ("c2", "-0.2", "shear of the second layer, |c2 − c1| ≥ 0.05"),
+            ("c1", "0.5", "shear of the first layer, in [-16, 16]"),
+            (
+                "c2",
+                "-0.2",
+                "shear of the second layer, in [-16, 16], |c2 − c1| ≥ 0.05",
+            ),
             ("mix", "0.5", "weight of the second layer, in [0, 1]"),
         ],
     },
