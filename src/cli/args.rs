@@ -133,6 +133,34 @@ impl DrawArgs {
     }
 }
 
+/// Refuses an output folder `path` (named by `option`) that is an existing
+/// file, before any work: a command that makes its folder only once it has
+/// something to write checks this first.
+///
+/// # Errors
+/// `path` is a file.
+pub fn check_folder(path: &std::path::Path, option: &str) -> anyhow::Result<()> {
+    if path.exists() && !path.is_dir() {
+        bail!(
+            "{option} {}: it is a file; give a folder (it is created if missing)",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Creates the output folder `path` (any depth), named by `option`: an
+/// existing file of that name is refused as such (the file system's
+/// "File exists" named neither the option nor the problem).
+///
+/// # Errors
+/// `path` is a file, or the folder cannot be created.
+pub fn create_folder(path: &std::path::Path, option: &str) -> anyhow::Result<()> {
+    check_folder(path, option)?;
+    std::fs::create_dir_all(path)
+        .with_context(|| format!("{option} {}: cannot create the folder", path.display()))
+}
+
 /// Checks every output before any work starts (a missing folder, a folder
 /// given as a file), so a long run does not end in a failed write.
 ///

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 
 use super::progress;
 use varspec::io::write_atomic;
@@ -97,8 +97,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.n < 3 {
         bail!("compare needs at least 3 points (-n)");
     }
-    std::fs::create_dir_all(&a.output)
-        .with_context(|| format!("cannot create folder {}", a.output.display()))?;
+    super::args::create_folder(&a.output, "-o")?;
     let bar = progress::bar(COMPARED.len() as u64, "sampling");
     let mut rows = Vec::new();
     let mut caveats = Vec::new();

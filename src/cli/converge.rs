@@ -280,7 +280,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 };
                 if let Some(other) = sets.iter().find(|s| s.len() != sets[0].len()) {
                     bail!(
-                        "{}: its sets hold {} and {} points; a level of the fit needs one N",
+                        "{}: its sets hold {} and {} points; a level of the fit needs one N (a \
+                         random-count process such as isotropic-jitter: converge --sampler draws \
+                         its levels, or predict FILE --density λ gives one level's variance)",
                         path.display(),
                         sets[0].len(),
                         other.len()

@@ -66,6 +66,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| Path::new("out/experiments").join(parsed.name()));
+    super::args::check_folder(&out, "-o")?;
     let e = match parsed {
         ExperimentFile::Variance(e) => e,
         ExperimentFile::Figures(e) => {
@@ -75,8 +76,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 );
             }
             let bar = progress::bar(e.figures.len() as u64, &e.name);
-            std::fs::create_dir_all(&out)
-                .with_context(|| format!("{file}: cannot create {}", out.display()))?;
+            super::args::create_folder(&out, "-o")?;
             varspec::experiment::remove_variance_runs(&out)?;
             let md = e.run(&file, &out, &|i, seconds| {
                 bar.inc(1);
@@ -94,8 +94,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let cells = run_items(&e, &file, shard, &|| bar.inc(1))?;
     bar.finish_and_clear();
     // The folder is made only once there is something to write.
-    std::fs::create_dir_all(&out)
-        .with_context(|| format!("{file}: cannot create {}", out.display()))?;
+    super::args::create_folder(&out, "-o")?;
     varspec::experiment::remove_other_runs(&out, a.shard)?;
     if a.shard.is_some() {
         let name = shard_file_name(SHARD_PREFIX, shard.index, shard.count);
@@ -125,7 +124,7 @@ pub fn merge(a: MergeArgs) -> anyhow::Result<()> {
     )?;
     let (e, file, cells) = merge_shards(&shards)?;
     let out = a.output.unwrap_or(a.folder);
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    super::args::create_folder(&out, "-o")?;
     write_results(&e, &file, &cells, &out)?;
     outln!(
         "merged {} shards of {} into {}",

@@ -81,9 +81,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if given.is_none() && range >= largest && 0.99 * largest >= a.bandwidth {
         range = 0.99 * largest;
         eprintln!(
-            "note: --range {range:.3} r_max (not {DEFAULT_RANGE}): with N = {n} in {d}D the pair \
-             correlation aliases beyond {:.3} r_max, half the torus, less 6 kernel widths",
-            0.5 / unit
+            "note: --range {range:.3} r_max (not {DEFAULT_RANGE}): with N = {n} in {d}D half the \
+             torus is {:.3} r_max, and the range plus 6 kernel widths ({:.3} r_max) must stay \
+             below it, where the pair correlation would alias",
+            0.5 / unit,
+            6.0 * a.bandwidth
         );
     }
     let reach = range + 6.0 * a.bandwidth;

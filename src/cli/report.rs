@@ -32,6 +32,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.n < 4 || a.sets < 2 {
         anyhow::bail!("report needs -n >= 4 and --sets >= 2");
     }
+    // The tour makes the folder once its options pass.
+    super::args::check_folder(&a.output, "-o")?;
     let options = TourOptions {
         n: a.n,
         sets: a.sets,

@@ -257,8 +257,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .flatten()
         .collect();
     if written.is_empty() {
-        let mut out = std::io::stdout().lock();
-        radial_csv(&mut out)?;
+        // Through the command's standard output, which reports a failed
+        // write as such (`> /dev/full`) and a reader that left as none.
+        let mut table = Vec::new();
+        radial_csv(&mut table)?;
+        super::stdout::bytes(&table);
     }
     super::stdout::wrote(written);
     Ok(())

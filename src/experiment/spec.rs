@@ -183,10 +183,17 @@ impl Experiment {
             }
             let side = 2 * r.half as u64 + 1;
             let frequencies = side.checked_pow(dims[0] as u32).unwrap_or(u64::MAX);
-            if r.half == 0 || frequencies > RADIAL_FREQUENCIES {
+            if r.half == 0 {
+                return Err(invalid(
+                    "radial.half = 0: the box |k| <= half must hold a frequency besides 0; give \
+                     at least 1"
+                        .into(),
+                ));
+            }
+            if frequencies > RADIAL_FREQUENCIES {
                 return Err(invalid(format!(
-                    "radial.half = {} must be at least 1 and keep the box within {RADIAL_FREQUENCIES} frequencies \
-                     ({side}^{} = {frequencies} in {}D)",
+                    "radial.half = {}: the box of (2·half + 1)^{} = {frequencies} frequencies in \
+                     {}D is over the {RADIAL_FREQUENCIES} allowed",
                     r.half, dims[0], dims[0]
                 )));
             }

@@ -99,7 +99,12 @@ impl Family {
             }
             _ => {
                 return Err(fail(format!(
-                    "unknown family `{name}` (known: gaussians, halfplanes, disks, boxes, file:PATH)"
+                    "unknown family `{name}`{} (known: gaussians, halfplanes, disks, boxes, \
+                     file:PATH)",
+                    crate::suggest::did_you_mean(
+                        name,
+                        ["gaussians", "halfplanes", "disks", "boxes", "file"]
+                    )
                 )));
             }
         };

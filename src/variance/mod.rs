@@ -70,7 +70,8 @@ pub enum VarianceError {
     /// Realizations of different sizes in a Fourier prediction.
     #[error(
         "the Fourier predictor needs every set to have the same N (found {first} and {other}), \
-         or to come from one random-count process of known density (point files: --density)"
+         or to come from one random-count process of known density (point files: --density); \
+         the spatial and empirical forms take sets of any N (--method spatial,empirical)"
     )]
     MixedSizes {
         /// One size.

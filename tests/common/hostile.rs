@@ -109,7 +109,7 @@ pub fn write_fixtures(dir: &Path) {
     // A 4 × 4 grey PFM (little-endian), a reference of the wrong size.
     let mut pfm = b"Pf\n4 4\n-1.0\n".to_vec();
     pfm.extend((0..16).flat_map(|i| (i as f32 / 16.0).to_le_bytes()));
-    let files: [(&str, Vec<u8>); 15] = [
+    let files: [(&str, Vec<u8>); 16] = [
         (
             "three.csv",
             "set,x0,x1\n0,0.1,0.2\n0,0.6,0.7\n1,0.3,0.4\n1,0.8,0.9\n2,0.5,0.1\n2,0.0,0.6\n".into(),
@@ -125,6 +125,10 @@ pub fn write_fixtures(dir: &Path) {
         ("huge-weights.csv", "k,weight\n1,1e308\n2,1e308\n".into()),
         ("bom-weights.csv", "\u{feff}k,weight\n1,1\n2,0.5\n".into()),
         ("garbage.bin", "garbage\n".into()),
+        (
+            "small-exp.json",
+            experiment("small", r#""disk""#, "16, 64").into(),
+        ),
         (
             "escape.json",
             experiment("../../escaped", r#""disk""#, "64, 256").into(),
