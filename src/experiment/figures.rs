@@ -612,9 +612,9 @@ impl FigureExperiment {
         on_figure: &dyn Fn(usize, f64),
     ) -> Result<String, ExperimentError> {
         let mut md = format!(
-            "# {}\n\n{}\n\nCommand: `cargo run --release -- experiment {file} -o <this folder>` \
-             (seed {}).\n\n",
-            self.name, self.description, self.seed
+            "{}Command: `cargo run --release -- experiment {file} -o <this folder>` (seed {}).\n\n",
+            super::report::heading(&self.name, &self.description),
+            self.seed
         );
         for (i, figure) in self.figures.iter().enumerate() {
             let fail = |reason: String| ExperimentError::Figure {

@@ -99,8 +99,8 @@ pub fn write_results(
         .map(|s| integrands::parse(s).expect("validated with the experiment"))
         .collect();
     let mut md = format!(
-        "# {}\n\n{}\n\nCommand: `cargo run --release -- experiment {file} -o <this folder>`\n\n",
-        e.name, e.description
+        "{}Command: `cargo run --release -- experiment {file} -o <this folder>`\n\n",
+        heading(&e.name, &e.description)
     );
     md += &format!(
         "Sampler-level predictions of the shift-randomized estimator's variance, mean over {} \
@@ -443,4 +443,23 @@ pub(super) fn write_csv(
     let bytes = w.into_inner().map_err(|err| fail(name, err.to_string()))?;
     write_atomic(&out.join(name), |w| w.write_all(&bytes))
         .map_err(|err| fail(name, err.to_string()))
+}
+
+/// An experiment README's title and description paragraph (none for an
+/// empty description, which left an empty paragraph).
+pub(crate) fn heading(name: &str, description: &str) -> String {
+    if description.trim().is_empty() {
+        format!("# {name}\n\n")
+    } else {
+        format!("# {name}\n\n{description}\n\n")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn an_empty_description_leaves_no_empty_paragraph() {
+        assert_eq!(super::heading("x", " "), "# x\n\n");
+        assert_eq!(super::heading("x", "A sweep."), "# x\n\nA sweep.\n\n");
+    }
 }
