@@ -133,6 +133,22 @@ impl DrawArgs {
     }
 }
 
+/// A picture's path: the file is written as PNG, so a name ending in
+/// another extension (`--png s.csv`) is refused rather than filled with
+/// PNG bytes; no extension (`/dev/null`) is fine.
+///
+/// # Errors
+/// A sentence naming the path.
+pub fn png_path(text: &str) -> Result<std::path::PathBuf, String> {
+    let path = std::path::PathBuf::from(text);
+    match path.extension().map(|e| e.to_string_lossy().to_lowercase()) {
+        Some(ext) if ext != "png" => Err(format!(
+            "`{text}`: a PNG picture is written here (not .{ext}); name the file .png"
+        )),
+        _ => Ok(path),
+    }
+}
+
 /// Refuses an output folder `path` (named by `option`) that is an existing
 /// file, before any work: a command that makes its folder only once it has
 /// something to write checks this first.

@@ -79,7 +79,7 @@ pub struct Args {
     #[arg(long)]
     csv: Option<PathBuf>,
     /// Log-log PNG plot with reference slopes.
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::png_path)]
     png: Option<PathBuf>,
     /// Print one JSON object.
     #[arg(long)]

@@ -138,7 +138,7 @@ pub struct PointsArgs {
     #[arg(long)]
     curve: Option<PathBuf>,
     /// Log-log PNG of set 0's loss against wall time, with the classic samplers' losses.
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::png_path)]
     curve_png: Option<PathBuf>,
     /// Torus, 2D blue-noise targets: coarse-to-fine, a first phase (at most
     /// 300 iterations) on a quarter of the box, then the full box from a

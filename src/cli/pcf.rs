@@ -30,7 +30,7 @@ pub struct Args {
     #[arg(long)]
     csv: Option<PathBuf>,
     /// PNG plot of g against r / r_max.
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::png_path)]
     png: Option<PathBuf>,
 }
 

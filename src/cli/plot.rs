@@ -30,7 +30,7 @@ pub struct PointsArgs {
     #[arg(value_parser = super::args::whole::<u32>, allow_negative_numbers = true, long, default_value_t = 512)]
     size: u32,
     /// Output PNG.
-    #[arg(short = 'o', long = "output")]
+    #[arg(short = 'o', long = "output", value_parser = super::args::png_path)]
     output: PathBuf,
 }
 

@@ -50,7 +50,7 @@ pub struct Args {
     #[arg(value_parser = super::args::whole_at_least::<1, usize>, allow_negative_numbers = true, long, default_value_t = 1)]
     renders: usize,
     /// Tone-mapped PNG of the (mean) image (default out/render/SCENE.png).
-    #[arg(short = 'o', long = "output")]
+    #[arg(short = 'o', long = "output", value_parser = super::args::png_path)]
     output: Option<PathBuf>,
     /// Multiplier before tone mapping.
     #[arg(long, default_value_t = 1.0)]
@@ -63,7 +63,7 @@ pub struct Args {
     #[arg(long)]
     npy: Option<PathBuf>,
     /// Heat map PNG of log10 per-pixel variance, with a colour bar.
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::png_path)]
     variance_png: Option<PathBuf>,
     /// Colour range of --variance-png as log10 variance LO,HI, e.g. -6,-2
     /// (default: the image's own): give two renders the same to compare
@@ -86,7 +86,7 @@ pub struct Args {
     #[arg(long)]
     analysis: Option<PathBuf>,
     /// Heat map PNG of the light-field slope κ each pixel's shear follows.
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::png_path)]
     shear_png: Option<PathBuf>,
     /// Sampler parameter key=value (repeatable).
     #[arg(long = "param", value_parser = args::key_value)]

@@ -56,10 +56,10 @@ pub struct Args {
     #[arg(long)]
     radial: Option<PathBuf>,
     /// PNG heat map of the spectrum (log scale, centred at DC).
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::png_path)]
     png: Option<PathBuf>,
     /// PNG plot of the radial profile.
-    #[arg(long)]
+    #[arg(long, value_parser = super::args::png_path)]
     radial_png: Option<PathBuf>,
 }
 
