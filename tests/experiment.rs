@@ -81,6 +81,17 @@ fn shards_merged_equal_the_single_run_byte_for_byte() {
         &["merge", partial.to_str().unwrap()],
         "shard 1/3 is missing",
     );
+    // A shard file copied under another shard's name is named, file and
+    // content (it read "shard 0/3 given twice": fourth trial).
+    std::fs::copy(
+        partial.join("shard-0-of-3.json"),
+        partial.join("shard-1-of-3.json"),
+    )
+    .unwrap();
+    assert_fails(
+        &["merge", partial.to_str().unwrap()],
+        "shard-1-of-3.json: it holds shard 0/3, whose file is shard-0-of-3.json",
+    );
     assert_fails(&["experiment", f, "--shard", "3/3"], "0 <= i < n");
     // Runs of the other kind into one folder: a whole run removes the
     // shards, a shard run the tables and shards of another split; a user's

@@ -121,6 +121,7 @@ pub fn merge(a: MergeArgs) -> anyhow::Result<()> {
         SHARD_PREFIX,
         1 << 30,
         "an experiment shard of this varspec version (re-run shards an older one wrote)",
+        |s: &ShardFile| (s.shard.index, s.shard.count),
     )?;
     let (e, file, cells) = merge_shards(&shards)?;
     let out = a.output.unwrap_or(a.folder);

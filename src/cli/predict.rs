@@ -362,13 +362,20 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if wants(MethodArg::Empirical) {
         let start = Instant::now();
         let shifted = shift.dims(f.dim());
+        // Each realization is fetched once, as its estimate starts.
+        let bar = progress::bar(realizations as u64, "empirical form, realizations");
         let e = empirical_shifting(
             f.as_ref(),
             realizations,
             DEFAULT_SHIFT_SEED,
             &shifted,
-            |r| source.get_cyclic(r).map_err(|e| realization_error(r, e)),
-        )?;
+            |r| {
+                bar.inc(1);
+                source.get_cyclic(r).map_err(|e| realization_error(r, e))
+            },
+        );
+        bar.finish_and_clear();
+        let e = e?;
         out.insert(
             "empirical".into(),
             json!({

@@ -243,5 +243,11 @@ fn read_table_shards(output: &std::path::Path) -> anyhow::Result<Vec<TableShard>
         .file_name()
         .context("--merge needs -o naming the table file")?;
     let prefix = format!("{}.shard-", file.to_string_lossy());
-    Ok(read_shard_files(folder, &prefix, 1 << 34, "a table shard")?)
+    Ok(read_shard_files(
+        folder,
+        &prefix,
+        1 << 34,
+        "a table shard",
+        |s: &TableShard| (s.shard.index, s.shard.count),
+    )?)
 }

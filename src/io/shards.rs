@@ -35,6 +35,21 @@ pub enum ShardFilesError {
         /// Why.
         reason: String,
     },
+    /// A shard file whose name is another shard's.
+    #[error(
+        "{path}: it holds shard {index}/{count}, whose file is {name}: a shard file was copied \
+         or renamed"
+    )]
+    Misnamed {
+        /// The file.
+        path: PathBuf,
+        /// The shard it holds.
+        index: usize,
+        /// Of how many.
+        count: usize,
+        /// That shard's file name.
+        name: String,
+    },
 }
 
 /// The name of shard `index` of `count` under `prefix`.
@@ -43,7 +58,10 @@ pub fn shard_file_name(prefix: &str, index: usize, count: usize) -> String {
 }
 
 /// Every `{prefix}*.json` in `folder`, in name order, each read (at most
-/// `limit` bytes, described as `what` in errors) and parsed as `T`.
+/// `limit` bytes, described as `what` in errors) and parsed as `T`, whose
+/// shard (index, count) `shard_of` gives must be the one its file name
+/// says (a shard file copied or renamed is refused by name, rather than
+/// reported later as a shard given twice).
 ///
 /// # Errors
 /// [`ShardFilesError`] naming the folder or the file.
@@ -52,6 +70,7 @@ pub fn read_shard_files<T: DeserializeOwned>(
     prefix: &str,
     limit: u64,
     what: &str,
+    shard_of: impl Fn(&T) -> (usize, usize),
 ) -> Result<Vec<T>, ShardFilesError> {
     let entries = std::fs::read_dir(folder).map_err(|cause| ShardFilesError::Folder {
         folder: folder.to_path_buf(),
@@ -82,7 +101,18 @@ pub fn read_shard_files<T: DeserializeOwned>(
             };
             let text =
                 super::read_text_bounded(&path, limit, what).map_err(|e| fail(e.to_string()))?;
-            super::from_json(&text).map_err(fail)
+            let shard: T = super::from_json(&text).map_err(fail)?;
+            let (index, count) = shard_of(&shard);
+            let name = shard_file_name(prefix, index, count);
+            if path.file_name().and_then(|n| n.to_str()) != Some(name.as_str()) {
+                return Err(ShardFilesError::Misnamed {
+                    path: path.clone(),
+                    index,
+                    count,
+                    name,
+                });
+            }
+            Ok(shard)
         })
         .collect()
 }
