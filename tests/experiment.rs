@@ -393,7 +393,7 @@ fn duplicates_after_adjustment_are_refused_naming_the_values() {
         ),
         (
             SMALL.replace("\"half\": 20", "\"half\": 0"),
-            "radial.half = 0 must be at least 1",
+            "radial.half = 0: the box |k| <= half must hold a frequency besides 0; give at least 1",
         ),
         (
             SMALL.replace("[\"random\", \"jitter\", \"cmj\"]", "[]"),
