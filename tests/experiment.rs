@@ -409,7 +409,7 @@ fn duplicates_after_adjustment_are_refused_naming_the_values() {
         ),
         (
             SMALL.replace("\"half\": 20", "\"half\": 5000"),
-            "(10001^2 = 100020001 in 2D)",
+            "radial.half = 5000: the box of (2·half + 1)^2 = 100020001 frequencies in 2D is over the 67108864 allowed",
         ),
         (
             SMALL.replace("\"half\": 20", "\"halfwidth\": 20"),
