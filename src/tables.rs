@@ -181,8 +181,8 @@ pub fn metadata(
             "the reference integrands are 2D and the sets are {dim}D"
         )),
         PredictedVariances::OverBudget { pairs } => Some(format!(
-            "{pairs:.3e} pair evaluations ({} integrands x N^2 x {} sets) exceed 2^28; \
-             `tables --variance` computes them",
+            "{pairs:.3e} pair evaluations ({} integrands x N^2 x {} sets) exceed 2^28; pass \
+             --variance to compute them",
             REFERENCE_INTEGRANDS.len(),
             sets.len()
         )),

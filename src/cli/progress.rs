@@ -150,20 +150,28 @@ pub fn duration_words(d: Duration) -> String {
 /// starts.
 const LONG_WORK: f64 = 60.0;
 
+/// Pair evaluations per second below any measured rate of the spatial
+/// form (1.7e7 on the default disk, 4e7 on lighter integrands, on 2
+/// cores): work under [`LONG_WORK`] times this cannot take a minute, and
+/// is not timed.
+const SLOWEST_PAIRS_PER_SECOND: f64 = 1e6;
+
 /// Before the spatial form runs on `runs` (N, sets): a note when it would
 /// take over a minute here, with the pair evaluations and the time
-/// ([`varspec::variance::estimated_seconds`]), since its cost is O(N²) per
-/// set and nothing else warns of a run that takes days.
+/// ([`varspec::variance::estimated_seconds`], one probe for all runs),
+/// since its cost is O(N²) per set and nothing else warns of a run that
+/// takes days. Work too small to matter is not probed.
 pub fn note_spatial_cost(f: &dyn varspec::integrands::Integrand, runs: &[(usize, usize)]) {
-    let mut seconds = 0.0;
-    let mut pairs = 0.0;
-    for &(n, sets) in runs {
-        let Ok(s) = varspec::variance::estimated_seconds(f, n, sets) else {
-            return;
-        };
-        seconds += s;
-        pairs += sets as f64 * varspec::variance::pair_evaluations(f, n);
+    let pairs: f64 = runs
+        .iter()
+        .map(|&(n, sets)| sets as f64 * varspec::variance::pair_evaluations(f, n))
+        .sum();
+    if pairs < LONG_WORK * SLOWEST_PAIRS_PER_SECOND {
+        return;
     }
+    let Ok(seconds) = varspec::variance::estimated_seconds(f, runs) else {
+        return;
+    };
     if seconds > LONG_WORK {
         eprintln!(
             "note: the spatial form is O(N^2) per set: {pairs:.1e} pair evaluations, about {} \

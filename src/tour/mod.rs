@@ -331,7 +331,7 @@ impl TourOptions {
             * self.sets as f64
             * crate::variance::pair_evaluations(f.as_ref(), self.n);
         if pairs > REPORT_PAIRS {
-            let hours = crate::variance::estimated_seconds(f.as_ref(), self.n, self.sets)
+            let hours = crate::variance::estimated_seconds(f.as_ref(), &[(self.n, self.sets)])
                 .map_or(f64::NAN, |s| s * SECTION_ONE_SAMPLERS as f64 / 3600.0);
             return Err(at("the sampler comparison (-n, --sets)")(format!(
                 "-n {} with --sets {} costs {pairs:.1e} pair evaluations of the exact spatial \

@@ -59,15 +59,17 @@ pub fn pair_evaluations(f: &dyn Integrand, n: usize) -> f64 {
     pairs * ball.min(1.0)
 }
 
-/// Seconds [`spatial`] would take here on `sets` sets of `n` points of
-/// `f`'s dimension: one set of min(n, 2048) random points is timed and the
-/// time scaled by [`pair_evaluations`] (the cost is O(N²) per set, so a
-/// request can run for days; commands say so before they start).
+/// Seconds [`spatial`] would take here on every (N, sets) of `runs`, sets
+/// of `f`'s dimension: one set of min(largest N, 2048) random points is
+/// timed once and the time scaled by [`pair_evaluations`] (the cost is
+/// O(N²) per set, so a request can run for days; commands say so before
+/// they start).
 ///
 /// # Errors
 /// As [`spatial_variance`] (an integrand without c_f).
-pub fn estimated_seconds(f: &dyn Integrand, n: usize, sets: usize) -> Result<f64, VarianceError> {
-    let probe = n.clamp(2, 2048);
+pub fn estimated_seconds(f: &dyn Integrand, runs: &[(usize, usize)]) -> Result<f64, VarianceError> {
+    let largest = runs.iter().map(|&(n, _)| n).max().unwrap_or(0);
+    let probe = largest.clamp(2, 2048);
     let mut rng = crate::rng::set_rng(0, 0);
     let coords = (0..probe * f.dim())
         .map(|_| crate::rng::uniform(&mut rng))
@@ -75,8 +77,11 @@ pub fn estimated_seconds(f: &dyn Integrand, n: usize, sets: usize) -> Result<f64
     let set = PointSet::new(f.dim(), coords).expect("uniform values lie in [0, 1)");
     let start = std::time::Instant::now();
     spatial_variance(&set, f)?;
-    let probe_seconds = start.elapsed().as_secs_f64();
-    Ok(probe_seconds * sets as f64 * pair_evaluations(f, n) / pair_evaluations(f, probe).max(1.0))
+    let per_pair = start.elapsed().as_secs_f64() / pair_evaluations(f, probe).max(1.0);
+    Ok(runs
+        .iter()
+        .map(|&(n, sets)| per_pair * sets as f64 * pair_evaluations(f, n))
+        .sum())
 }
 
 /// The spatial prediction, averaged over realizations.
