@@ -18,10 +18,11 @@ use rayon::prelude::*;
 
 use varspec::integrands::{self, Integrand};
 use varspec::optimize::adapted::design_sets;
-use varspec::optimize::lattice::{Lattice, best_lattice};
+use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, PointOptimizer, Target};
 use varspec::registry;
 use varspec::rng::{set_rng, uniform};
+use varspec::samplers::Lattice;
 use varspec::variance::{VarianceError, spatial};
 
 /// (1/N) Σ_i Σ_j c_f(x_i − x_j)/N for the union of `points` and `points` +

@@ -144,7 +144,7 @@ pub const SAMPLERS: &[SamplerInfo] = &[
             default: "auto",
             help: "Korobov generator: the rank-1 lattice (i/N, g*i/N mod 1), 1 <= g < N; auto = the best spectral test over every lattice of N points",
         }],
-        build: crate::optimize::lattice::from_config,
+        build: crate::samplers::lattice::from_config,
     },
     SamplerInfo {
         name: "umj",

@@ -841,7 +841,7 @@ fn predict_draws_sets_for_its_standard_error_and_gives_closed_forms() {
             "--method",
             "expected",
         ],
-        "needs a sampler with a closed-form expected spectrum",
+        "needs a sampler with a closed form",
     );
 }
 
@@ -946,7 +946,7 @@ fn converge_with_closed_form_expectations() {
             "--n",
             "16,64",
         ],
-        "nrooks has no closed-form expected spectrum",
+        "nrooks has no closed form for",
     );
     common::assert_fails(
         &[
@@ -992,8 +992,12 @@ fn loose_truncation_bounds_are_named() {
         note.contains("note: fourier: its truncation_bound is"),
         "{note}"
     );
-    // A lattice's closed form: its dual points beyond the box.
-    let out = common::varspec_ok(&[
+    // A lattice's closed form is the exact lattice sum, equal to the
+    // generic spatial form of its sets (exact for a lattice, whatever the
+    // shift), with no truncation and so no note; the Fourier form's
+    // expected spectrum gave 7.30e-7 here with a worst-case tail bound
+    // 559× that (the exact value is 7.86e-7).
+    let args = [
         "predict",
         "--sampler",
         "regular",
@@ -1002,13 +1006,46 @@ fn loose_truncation_bounds_are_named() {
         "--integrand",
         "box:w=0.4,h=0.2,angle=30",
         "--method",
-        "expected",
-    ]);
-    let note = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        note.contains("note: expected: its truncation_bound is"),
-        "{note}"
+        "expected,spatial",
+        "--sets",
+        "2",
+        "--json",
+    ];
+    let out = common::varspec_ok(&args);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let e = &v["expected"];
+    assert_eq!(e["form"], "lattice sum", "{v}");
+    assert_eq!(e["lattice"], serde_json::json!({"a": 32, "b": 0, "c": 32}));
+    assert_eq!(e["truncation_bound"].as_f64(), Some(0.0));
+    let (exact, spatial) = (
+        e["variance"].as_f64().unwrap(),
+        v["spatial"]["variance"].as_f64().unwrap(),
     );
+    assert!(
+        (exact - spatial).abs() <= 1e-9 * spatial,
+        "lattice sum {exact:e} vs spatial {spatial:e}"
+    );
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(!note.contains("truncation_bound"), "{note}");
+    let v = json(&[
+        "converge",
+        "--sampler",
+        "uniform-jitter",
+        "--integrand",
+        "disk:r=0.3",
+        "--method",
+        "expected",
+        "--n",
+        "64,256,1024",
+        "--json",
+    ]);
+    assert!(
+        v["method"].as_str().unwrap().contains("exact lattice sum"),
+        "{v}"
+    );
+    let tiny = v["points"][1]["variance"].as_f64().unwrap();
+    // The Python lens-area sum (tests/expected_predictor.rs).
+    assert!((tiny - 4.2946259087892774e-05).abs() <= 1e-12 * tiny, "{v}");
     let out = common::varspec_ok(&[
         "converge",
         "--sampler",

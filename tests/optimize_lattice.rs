@@ -7,11 +7,12 @@ use crate::common;
 
 use varspec::integrands;
 use varspec::optimize::adapted::{design_sets, keep_lower_variance};
-use varspec::optimize::lattice::{best_lattice, lattices};
+use varspec::optimize::lattice::best_lattice;
 use varspec::optimize::{DescentOptions, DescentResult, PointOptimizer, Target};
 use varspec::registry;
 use varspec::rng::set_rng;
 use varspec::samplers::Sampler;
+use varspec::samplers::lattice::lattices;
 use varspec::variance::{SpatialEstimate, VarianceError, spatial, spatial_variance};
 
 /// The lattice rule's N-term form equals the generic all-pairs spatial

@@ -14,11 +14,10 @@ use varspec::integrands;
 use varspec::io::write_atomic;
 use varspec::registry;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
-use varspec::samplers::ClosedFormSpectrum;
 use varspec::source::Source;
 use varspec::square::{Family, family_mse};
 use varspec::variance::{
-    SamplerVariance, VarianceForm, fit_slope, fourier_expected, sampler_variance, theoretical_rate,
+    ClosedForm, SamplerVariance, VarianceForm, fit_slope, sampler_variance, theoretical_rate,
 };
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -27,10 +26,12 @@ enum MethodArg {
     Spatial,
     /// Fourier form with the Parseval tail.
     Fourier,
-    /// The Fourier form with the sampler's closed-form expected spectrum
-    /// (2D random, jitter, regular, uniform-jitter, multijitter, cmj; 4D umj
-    /// and padded sets of those): the expected variance itself at each N,
-    /// no sets and no sampling noise.
+    /// The sampler's expected variance in closed form at each N, no sets
+    /// and no sampling noise: the exact lattice sum for regular,
+    /// uniform-jitter and lattice on an integrand with a closed-form
+    /// autocovariance, else the Fourier form with the sampler's expected
+    /// spectrum (2D random, jitter, regular, uniform-jitter, multijitter,
+    /// cmj; 4D umj and padded sets of those).
     Expected,
 }
 
@@ -222,6 +223,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let bar = progress::share_bar(weights.iter().sum(), "converge");
     let mut points = Vec::new();
+    // The closed form --method expected used (the same at every level).
+    let mut expected_form = None;
     // Levels whose sampler is not what its name promises (a thin
     // multi-jittered grid): the table's rate is not theirs.
     let mut caveats = 0;
@@ -310,23 +313,25 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 });
                 let e = match (method, &source) {
                     (MethodArg::Expected, Source::Sampler { sampler, .. }) => {
-                        let closed = ClosedFormSpectrum::of(sampler.as_ref())
-                            .filter(|c| c.dim() == dim)
-                            .with_context(|| {
+                        let closed =
+                            ClosedForm::of(sampler.as_ref(), f.as_ref()).with_context(|| {
                                 format!(
-                                    "--method expected: {label} has no closed-form expected \
-                                     spectrum in {dim}D (2D random, jitter, regular, \
-                                     uniform-jitter, multijitter and cmj have one, 4D umj and \
-                                     padded sets of those); use --method spatial or fourier"
+                                    "--method expected: {label} has no closed form for {name} in \
+                                 {dim}D (a closed-form expected spectrum: 2D random, jitter, \
+                                 regular, uniform-jitter, multijitter and cmj, 4D umj and padded \
+                                 sets of those; or a lattice: regular, uniform-jitter and \
+                                 lattice on an integrand with a closed-form autocovariance); use \
+                                 --method spatial or fourier"
                                 )
                             })?;
+                        expected_form = Some(closed.name());
                         // Without --res the box grows with N where that
                         // matters (variance::expected_min_half).
                         let half = match a.res {
                             None => half.max(varspec::variance::expected_min_half(dim, n)),
                             Some(_) => half,
                         };
-                        let p = fourier_expected(f.as_ref(), half, &closed)?.estimate;
+                        let p = closed.variance(f.as_ref(), half)?;
                         SamplerVariance {
                             variance: p.variance,
                             stderr: 0.0,
@@ -494,6 +499,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 (Subject::Square(_), _) => "square: unshifted estimator's MSE over the family (brute force)",
                 (_, MethodArg::Spatial) => "spatial",
                 (_, MethodArg::Fourier) => "fourier",
+                (_, MethodArg::Expected) if expected_form == Some("lattice sum") => "expected: the exact lattice sum (1/N)·Σ c_f over the lattice",
                 (_, MethodArg::Expected) => "expected: the sampler's closed-form expected spectrum",
             },
             "sets": points_sets,

@@ -12,22 +12,23 @@ use super::progress;
 use super::source::{SourceArgs, realization_error};
 use varspec::PointSet;
 use varspec::integrands::{self, Integrand};
-use varspec::samplers::ClosedFormSpectrum;
 use varspec::scene::pixel::PixelIntegrand;
 use varspec::source::Source;
 use varspec::variance::{
-    DEFAULT_SHIFT_SEED, TARGET_RELATIVE_STDERR, VarianceError, auto_set_cap, empirical_shifting,
-    expected_min_half, fourier_expected, fourier_parts, radial_from, sets_for_relative_stderr,
+    ClosedForm, DEFAULT_SHIFT_SEED, TARGET_RELATIVE_STDERR, VarianceError, auto_set_cap,
+    empirical_shifting, expected_min_half, fourier_parts, radial_from, sets_for_relative_stderr,
     spatial,
 };
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum MethodArg {
     Fourier,
-    /// The Fourier form with the sampler's closed-form expected spectrum
-    /// (2D random, jitter, regular, uniform-jitter, multijitter, cmj; 4D
-    /// umj and padded sets of those): no realizations, no sampling error;
-    /// part of `all` where it exists.
+    /// The sampler's expected variance in closed form: the exact lattice
+    /// sum for regular, uniform-jitter and lattice on an integrand with a
+    /// closed-form autocovariance, else the Fourier form with the sampler's
+    /// expected spectrum (2D random, jitter, regular, uniform-jitter,
+    /// multijitter, cmj; 4D umj and padded sets of those): no realizations,
+    /// no sampling error; part of `all` where it exists.
     Expected,
     Spatial,
     Empirical,
@@ -237,23 +238,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     }
     let n = source.points_per_set();
-    // The closed-form expected spectrum of the sampler, if it has one.
+    // The sampler's closed form for f, if it has one: an exact lattice sum
+    // or its expected spectrum (variance::closed_form).
     let closed = match &source {
         Source::Sampler {
             sampler,
             dims: None,
             ..
-        } if f.has_fourier() => {
-            ClosedFormSpectrum::of(sampler.as_ref()).filter(|c| c.dim() == f.dim())
-        }
+        } => ClosedForm::of(sampler.as_ref(), f.as_ref()),
         _ => None,
     };
     if asks(MethodArg::Expected) && closed.is_none() {
         bail!(
-            "--method expected needs a sampler with a closed-form expected spectrum (2D random, \
-             jitter, regular, uniform-jitter, multijitter, cmj; 4D umj and padded sets of \
-             those; not a file or a projection) and an integrand with Fourier coefficients; {} \
-             on {} has none: use --method fourier",
+            "--method expected needs a sampler with a closed form (a closed-form expected \
+             spectrum: 2D random, jitter, regular, uniform-jitter, multijitter, cmj, 4D umj and \
+             padded sets of those, with an integrand that has Fourier coefficients; or a \
+             lattice: regular, uniform-jitter and lattice, with an integrand that has a \
+             closed-form autocovariance), not a file or a projection; {} on {} has none: use \
+             --method fourier",
             source.name(),
             f.spec()
         );
@@ -292,19 +294,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             fourier.max(2 * expected_min_half(f.dim(), n) + 1)
         });
         let start = Instant::now();
-        let e = fourier_expected(f.as_ref(), res.saturating_sub(1) / 2, &closed)?.estimate;
-        out.insert(
-            "expected".into(),
-            json!({
-                "variance": e.variance, "truncation_bound": e.truncation_bound,
-                "rounding_bound": e.rounding_bound, "in_box": e.in_box, "tail": e.tail,
-                "axis_strips": e.strips.map(|s| json!({
+        let e = closed.variance(f.as_ref(), res.saturating_sub(1) / 2)?;
+        let mut entry = json!({
+            "variance": e.variance, "truncation_bound": e.truncation_bound,
+            "rounding_bound": e.rounding_bound, "form": closed.name(),
+        });
+        match (&closed, &e.fourier) {
+            (ClosedForm::Lattice(lattice), _) => {
+                entry["lattice"] = json!(lattice);
+            }
+            (_, Some(p)) => {
+                entry["in_box"] = json!(p.in_box);
+                entry["tail"] = json!(p.tail);
+                entry["axis_strips"] = json!(p.strips.map(|s| json!({
                     "half_width": s.width, "reach": s.reach,
                     "correction": s.correction / n as f64,
-                })),
-                "res": res, "seconds": start.elapsed().as_secs_f64(),
-            }),
-        );
+                })));
+                entry["res"] = json!(res);
+            }
+            _ => {}
+        }
+        entry["seconds"] = json!(start.elapsed().as_secs_f64());
+        out.insert("expected".into(), entry);
     }
     // The Fourier, radial and spatial forms pass over the same
     // realizations: draw them once (a sampler's draw can be costly, e.g. an
@@ -459,6 +470,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 _ if v.get("skipped").is_some() => {
                     v["skipped"].as_str().unwrap_or_default().to_string()
                 }
+                "expected" if v["lattice"].is_object() => format!(
+                    "exact lattice sum (1/N)·Σ c_f over the {n} lattice points: no sampling error, \
+                     no truncation"
+                ),
                 "expected" => format!(
                     "closed-form E[P_S], no sampling error  {extra} {:.2e}",
                     v[extra].as_f64().unwrap_or(f64::NAN)

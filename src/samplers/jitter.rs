@@ -9,6 +9,7 @@
 
 use rustfft::num_complex::Complex64;
 
+use super::Lattice;
 use super::config::{Config, integer_root, pow_saturating};
 use super::{Sampler, SamplerError};
 use crate::points::{PointSet, stratum_coord};
@@ -111,6 +112,17 @@ impl Sampler for Jitter {
 
     fn pair_spectrum(&self) -> Option<&dyn PairSpectrum> {
         (self.dim == 2).then_some(self as &dyn PairSpectrum)
+    }
+
+    /// The regular grid and uniform jitter in 2D are the m × m lattice
+    /// (m, 0, m) under a shift (none for cell centres: the estimator's own
+    /// shift randomizes them).
+    fn lattice(&self) -> Option<Lattice> {
+        (self.dim == 2 && self.offset != StratumOffset::Independent).then_some(Lattice {
+            a: self.m,
+            b: 0,
+            c: self.m,
+        })
     }
 }
 

@@ -12,6 +12,7 @@ pub mod config;
 pub(crate) mod halton;
 pub(crate) mod isotropic_jitter;
 pub(crate) mod jitter;
+pub mod lattice;
 pub(crate) mod multijitter;
 pub(crate) mod nrooks;
 pub(crate) mod padded;
@@ -24,6 +25,7 @@ pub use closed_form::ClosedFormSpectrum;
 pub use halton::Halton;
 pub use isotropic_jitter::IsotropicJitter;
 pub use jitter::{Jitter, StratumOffset};
+pub use lattice::Lattice;
 pub use multijitter::MultiJitter;
 pub use nrooks::NRooks;
 pub use padded::Padded;
@@ -64,6 +66,13 @@ pub trait Sampler: Send + Sync {
     /// 2D halves paired by a uniformly random permutation); `None` for
     /// every other sampler.
     fn halves(&self) -> Option<[&dyn Sampler; 2]> {
+        None
+    }
+    /// The 2D integration lattice every realization is a uniformly shifted
+    /// copy of (the regular grid, uniform jitter, the lattice rule), whose
+    /// expected variance is an exact N-term sum
+    /// ([`crate::variance::lattice`]); `None` for every other sampler.
+    fn lattice(&self) -> Option<Lattice> {
         None
     }
     /// What a user should know about this instance that its name does not

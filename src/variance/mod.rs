@@ -8,9 +8,11 @@
 //! or fresh draws of a sampler with stream (seed, r)), so sampler-level
 //! predictions average the same realizations in every method.
 
+pub mod closed_form;
 pub mod convergence;
 pub mod empirical;
 pub mod fourier;
+pub mod lattice;
 pub mod measure;
 pub mod paired;
 pub mod radial;
@@ -18,12 +20,14 @@ pub mod sets;
 pub mod spatial;
 pub mod strips;
 
+pub use closed_form::{ClosedForm, ExpectedVariance};
 pub use convergence::{SlopeError, SlopeFit, fit_slope, theoretical_rate};
 pub use empirical::{
     DEFAULT_SHIFT_SEED, EmpiricalEstimate, NORMAL_95, empirical, empirical_shifting,
     shifted_estimates,
 };
 pub use fourier::{FourierEstimate, FourierParts, fourier, fourier_expected, fourier_parts};
+pub use lattice::{LatticeVariance, lattice_variance};
 pub use measure::{
     SamplerVariance, VarianceForm, expected_min_half, fourier_half, sampler_variance,
     zero_to_rounding,
