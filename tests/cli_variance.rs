@@ -1027,6 +1027,21 @@ fn loose_truncation_bounds_are_named() {
     );
     let note = String::from_utf8_lossy(&out.stderr);
     assert!(!note.contains("truncation_bound"), "{note}");
+    // --res has nothing to set there, and says so.
+    let mut with_res: Vec<&str> = args
+        .iter()
+        .map(|&x| {
+            if x == "expected,spatial" {
+                "expected"
+            } else {
+                x
+            }
+        })
+        .collect();
+    with_res.extend(["--res", "65"]);
+    let out = common::varspec_ok(&with_res);
+    let note = String::from_utf8_lossy(&out.stderr);
+    assert!(note.contains("--res is not used"), "{note}");
     let v = json(&[
         "converge",
         "--sampler",

@@ -332,6 +332,11 @@ pub fn count(text: &str) -> Result<usize, String> {
 /// named (predict, converge).
 pub const LOOSE_TRUNCATION: f64 = 0.1;
 
+/// Why `--res` does nothing to a lattice's expected variance
+/// (`variance::ClosedForm::Lattice`).
+pub const LATTICE_HAS_NO_BOX: &str = "--res is not used: the expected variance of a shifted \
+     lattice is the exact lattice sum, which has no frequency box";
+
 /// Why a Fourier box's tail estimate can be far off, for the notes that
 /// name a loose truncation bound.
 pub const NOT_WHITE_BEYOND_THE_BOX: &str = "beyond the Fourier box the spectrum is not white \

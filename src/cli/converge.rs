@@ -324,6 +324,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                                  --method spatial or fourier"
                                 )
                             })?;
+                        if expected_form.is_none()
+                            && a.res.is_some()
+                            && matches!(closed, ClosedForm::Lattice(_))
+                        {
+                            eprintln!("note: {}", super::args::LATTICE_HAS_NO_BOX);
+                        }
                         expected_form = Some(closed.name());
                         // Without --res the box grows with N where that
                         // matters (variance::expected_min_half).

@@ -293,6 +293,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             let fourier = default_res(f.dim());
             fourier.max(2 * expected_min_half(f.dim(), n) + 1)
         });
+        if matches!(closed, ClosedForm::Lattice(_))
+            && a.res.is_some()
+            && !wants(MethodArg::Fourier)
+            && !wants(MethodArg::Radial)
+        {
+            eprintln!("note: {}", args::LATTICE_HAS_NO_BOX);
+        }
         let start = Instant::now();
         let e = closed.variance(f.as_ref(), res.saturating_sub(1) / 2)?;
         let mut entry = json!({
