@@ -227,7 +227,7 @@ pub const SAMPLERS: &[SamplerInfo] = &[
             max: sobol::MAX_DIM,
             default: 2,
         },
-        count: "any N <= 2^32; (0,m,2)-net in dims 0,1 when N = 2^m",
+        count: "any N with N*d < 2^32; (0,m,2)-net in dims 0,1 when N = 2^m",
         params: &[ParamInfo {
             key: "scramble",
             default: "owen",
@@ -372,7 +372,10 @@ pub fn build(
     // refuse a single set that does not fit before drawing it.
     let threads = rayon::current_num_threads() as f64 + 1.0;
     crate::memory::check(
-        &format!("{sampler}: a set of {n} points in {dim} dimensions, {threads} at a time"),
+        &format!(
+            "{sampler}: a set of {n} points in {dim}D, {threads} sets held at once (one per \
+             thread and one being written)"
+        ),
         Some(n as f64 * dim as f64 * 8.0 * threads),
         "lower -n",
     )?;

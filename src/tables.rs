@@ -31,8 +31,9 @@ pub struct Provenance {
     pub source: String,
     /// Sampler parameters.
     pub params: Vec<(String, String)>,
-    /// Seed.
-    pub seed: u64,
+    /// Seed of the sampler's sets; `None` for sets read from a file (drawn
+    /// elsewhere, with a seed the file does not record).
+    pub seed: Option<u64>,
     /// What the sets were designed for ([`optimized_for`]).
     pub optimized_for: String,
 }
@@ -172,8 +173,10 @@ pub fn metadata(
         Vec::new()
     };
     let value_type = match format {
-        TableFormat::F32 | TableFormat::CHeader => "f32 (float), little-endian where raw",
-        _ => "f64",
+        TableFormat::F32 => "f32 (float), little-endian",
+        TableFormat::CHeader => "f32 (float)",
+        TableFormat::F64 => "f64 (double), little-endian",
+        TableFormat::Csv | TableFormat::Json => "f64 as shortest round-trip decimal text",
     };
     let predicted_variance_skipped = match status {
         PredictedVariances::Computed => None,

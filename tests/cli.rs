@@ -572,6 +572,14 @@ fn plot_draws_a_projection_and_reports_bad_files_by_line() {
         png.to_str().unwrap(),
     ]);
     assert!(String::from_utf8_lossy(&bad_dims.stderr).contains("out of range"));
+    // An empty name is refused before the work (it printed "wrote :" and
+    // then failed: fifth trial).
+    let empty = varspec(&["plot", "points", points.to_str().unwrap(), "-o", ""]);
+    let err = String::from_utf8_lossy(&empty.stderr);
+    assert!(
+        !empty.status.success() && empty.stdout.is_empty() && err.contains("an empty file name"),
+        "{err}"
+    );
     // A 1D set is a strip of ticks (it was refused: third trial): at 64
     // pixels, the points 0.25 and 0.75 ink exactly the column pairs their
     // centres 15.5 and 47.5 straddle.

@@ -149,7 +149,7 @@ fn every_malformed_input_names_its_line() {
                     }
                 )
             },
-            "1 fields",
+            "1 field where",
         ),
         (
             "x0,x1\n0.1,0.2,0.3\n",
@@ -221,7 +221,7 @@ fn every_malformed_input_names_its_line() {
                     }
                 )
             },
-            "1 fields",
+            "1 field where",
         ),
         (
             "0.1 0.2\n#\n0.1 0.2 0.3\n",

@@ -133,7 +133,10 @@ fn every_format_round_trips() {
         let m = sidecar(&out(ext));
         assert_eq!((m.n, m.dim, m.sets), (32, 2, 3));
         assert!(m.generator.starts_with("varspec "));
+        // The file's sets were drawn elsewhere: no seed is claimed.
+        assert_eq!(m.seed, None, "{}", out(ext).display());
     }
+    assert!(doc["metadata"]["seed"].is_null(), "{doc}");
     // C header: the literals parse back to the f32 values, and it compiles.
     let header = std::fs::read_to_string(out("h")).unwrap();
     let body = &header[header.find("= {").unwrap()..];
@@ -179,7 +182,7 @@ fn f32_tables_stay_below_one() {
         generator: "test".into(),
         source: "test".into(),
         params: vec![],
-        seed: 0,
+        seed: Some(0),
         n: 2,
         dim: 2,
         sets: 1,
@@ -290,7 +293,7 @@ fn predicted_variance_matches_a_brute_force_shift_average() {
     let provenance = Provenance {
         source: "test".into(),
         params: vec![],
-        seed: 0,
+        seed: Some(0),
         optimized_for: "none".into(),
     };
     let (meta, status) = metadata(&[set], provenance, TableFormat::Csv, false).unwrap();
@@ -343,7 +346,7 @@ fn an_f32_tables_predicted_variance_is_that_of_its_stored_values() {
     let provenance = || Provenance {
         source: "test".into(),
         params: vec![],
-        seed: 3,
+        seed: Some(3),
         optimized_for: "none".into(),
     };
     let sets = [set.clone()];
@@ -577,5 +580,39 @@ fn the_documented_c_header_is_what_the_command_writes() {
         shown, actual,
         "docs/formats.md's C header example differs from the output"
     );
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// A C header's identifier is the output's name up to its last `.`
+/// (docs/formats.md): `.h` gives an empty name, so `table_` (it gave
+/// `table__h`: fifth trial).
+#[test]
+fn a_c_header_is_named_by_the_file_name_up_to_its_last_dot() {
+    let d = dir("c-names");
+    for (file, id) in [
+        (".h", "table_"),
+        ("cmj.256.h", "cmj_256"),
+        ("int.h", "table_int"),
+    ] {
+        let out = d.join(file);
+        varspec(&[
+            "tables",
+            "--sampler",
+            "cmj",
+            "-n",
+            "4",
+            "--sets",
+            "1",
+            "--format",
+            "c-header",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let header = std::fs::read_to_string(&out).unwrap();
+        assert!(
+            header.contains(&format!("static const float {id}[1][4][2]")),
+            "{file}: {header}"
+        );
+    }
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -140,6 +140,9 @@ impl DrawArgs {
 /// # Errors
 /// A sentence naming the path.
 pub fn png_path(text: &str) -> Result<std::path::PathBuf, String> {
+    if text.is_empty() {
+        return Err("an empty file name: name the PNG file, e.g. points.png".into());
+    }
     let path = std::path::PathBuf::from(text);
     match path.extension().map(|e| e.to_string_lossy().to_lowercase()) {
         Some(ext) if ext != "png" => Err(format!(

@@ -133,7 +133,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
 
-    outln!("2D samplers, {} sets each, seed {}:", a.sets, a.seed);
+    let sets = if a.sets == 1 { "set" } else { "sets" };
+    outln!("2D samplers, {} {sets} each, seed {}:", a.sets, a.seed);
     outln!(
         "{:<16} {:>6} {:>10} {:>8} {:>8}",
         "sampler",

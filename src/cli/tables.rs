@@ -111,7 +111,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         [a.from.as_deref()],
     )?;
     let mut run_params = a.draw.params.clone();
-    let mut run_seed = a.draw.seed();
+    let mut run_seed = Some(a.draw.seed());
     let mut run_sampler = a.sampler.clone();
     let (sets, source) = match (&a.sampler, &a.from) {
         _ if a.merge => {
@@ -119,7 +119,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             let (run, sets) = merge_table_shards(&shards)
                 .map_err(|e| anyhow::anyhow!("{}: {e}", a.output.display()))?;
             run_params = run.params;
-            run_seed = run.seed;
+            run_seed = Some(run.seed);
             run_sampler = Some(run.sampler.clone());
             (sets, run.sampler)
         }
@@ -151,6 +151,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     path.display()
                 );
             }
+            run_seed = None;
             (read_point_sets(path)?, path.display().to_string())
         }
         (None, None) => bail!("give --sampler or --from"),
@@ -168,10 +169,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     {
         eprintln!("predicted variances left out of the metadata: {why}");
     }
+    // The file's name up to its last `.` (docs/formats.md; `.h` gives an
+    // empty name, which c_identifier prefixes to `table_`).
     let name = a
         .output
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
+        .file_name()
+        .map(|s| {
+            let s = s.to_string_lossy();
+            s.rsplit_once('.')
+                .map_or(s.to_string(), |(stem, _)| stem.to_string())
+        })
         .unwrap_or_else(|| "table".into());
     write_atomic(&a.output, |w| write_table(w, &sets, &meta, format, &name))?;
     if let Some(sidecar) = &sidecar {

@@ -146,7 +146,8 @@ impl fmt::Display for LineProblem {
                 write!(f, "field {field} is {value}, outside [0, 1)")
             }
             LineProblem::Ragged { expected, found } => {
-                write!(f, "{found} fields where every row has {expected}")
+                let fields = if *found == 1 { "field" } else { "fields" };
+                write!(f, "{found} {fields} where every row has {expected}")
             }
             LineProblem::NotUtf8 => write!(f, "not UTF-8 text (is this a point-set file?)"),
             LineProblem::SetNumber {
@@ -531,12 +532,25 @@ fn coordinate(text: &str, field: usize) -> Result<f64, LineProblem> {
 /// reading the file back gives identical bits.
 ///
 /// # Errors
-/// The writer's I/O error.
+/// The writer's I/O error; `InvalidInput` for an empty set, which neither
+/// format can hold (a CSV's `set` column and a UTK file's `#` lines number
+/// only sets that have points, so reading the file back would lose it).
 pub fn write_point_sets(
     out: &mut dyn Write,
     sets: &[PointSet],
     format: PointFormat,
 ) -> io::Result<()> {
+    if let Some(empty) = sets.iter().position(PointSet::is_empty) {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "set {empty} of {} holds no points (a random-count sampler such as \
+                 isotropic-jitter can draw none at small N), and a point-set file cannot hold \
+                 an empty set: reading it back would lose or renumber the set; draw a larger N",
+                sets.len()
+            ),
+        ));
+    }
     let dim = sets.first().map_or(0, PointSet::dim);
     let numbered = sets.len() > 1;
     if format == PointFormat::Csv {

@@ -139,7 +139,7 @@ pub enum SamplerError {
     Memory(#[from] crate::memory::TooMuchMemory),
     /// N·d is too large to hold.
     #[error(
-        "{sampler}: {n} points in {dim} dimensions is more than this tool holds (fewer than 2^32 coordinates)"
+        "{sampler}: {n} points in {dim}D is more than this tool holds (fewer than 2^32 coordinates)"
     )]
     TooLarge {
         /// Sampler name.
