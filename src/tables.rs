@@ -36,6 +36,8 @@ pub struct Provenance {
     pub seed: Option<u64>,
     /// What the sets were designed for ([`optimized_for`]).
     pub optimized_for: String,
+    /// What a padded 4D table's dimensions are ([`dimensions`]).
+    pub dimensions: Option<String>,
 }
 
 /// Whether the predicted variances are in the metadata.
@@ -102,6 +104,54 @@ pub fn optimized_for(
     } else {
         "none".to_string()
     })
+}
+
+/// What the dimensions of a padded 4D table are, from the sampler's spec
+/// and parameters: dims 0, 1 the (x, y) half and 2, 3 the (u, v) half, two
+/// independent 2D sets whose points are paired by a uniformly random
+/// permutation (padding: Cook 1986; Singh & Jarosz 2017, §5). `None` for
+/// every other sampler (their dimensions are symmetric, or a sequence's
+/// own) and for sets read from a file.
+///
+/// # Errors
+/// An unknown sampler or a malformed spec ([`registry::split_spec`]).
+pub fn dimensions(
+    spec: Option<&str>,
+    params: &[(String, String)],
+) -> Result<Option<String>, SamplerError> {
+    let Some(spec) = spec else {
+        return Ok(None);
+    };
+    let (name, params) = registry::split_spec(spec, params)?;
+    let info = registry::find(name)?;
+    // The last value given wins, else the registry's default.
+    let param = |key: &str| {
+        params
+            .iter()
+            .rev()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| v.clone())
+            .or_else(|| {
+                info.params
+                    .iter()
+                    .find(|p| p.key == key)
+                    .map(|p| p.default.to_string())
+            })
+            .unwrap_or_default()
+    };
+    let halves = match info.name {
+        "umj" => {
+            let half = param("pairs");
+            [half.clone(), half]
+        }
+        "padded" => [param("xy"), param("uv")],
+        _ => return Ok(None),
+    };
+    Ok(Some(format!(
+        "dims 0, 1: (x, y) drawn by {}; dims 2, 3: (u, v) drawn by {}, independently; point i \
+         of the table pairs them by a uniformly random permutation (padding)",
+        halves[0], halves[1]
+    )))
 }
 
 /// The metadata of a table of `sets` in `format`; the predicted variances
@@ -200,6 +250,7 @@ pub fn metadata(
         sets: sets.len(),
         layout: format!("[set][point][dimension], {value_type}, values in [0, 1)"),
         optimized_for: provenance.optimized_for,
+        dimensions: provenance.dimensions,
         predicted_variance,
         predicted_variance_skipped,
     };

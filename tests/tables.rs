@@ -189,6 +189,7 @@ fn f32_tables_stay_below_one() {
         layout: String::new(),
         optimized_for: "none".into(),
         predicted_variance: vec![],
+        dimensions: None,
         predicted_variance_skipped: None,
     };
     let mut bytes = Vec::new();
@@ -295,6 +296,7 @@ fn predicted_variance_matches_a_brute_force_shift_average() {
         params: vec![],
         seed: Some(0),
         optimized_for: "none".into(),
+        dimensions: None,
     };
     let (meta, status) = metadata(&[set], provenance, TableFormat::Csv, false).unwrap();
     assert_eq!(status, PredictedVariances::Computed);
@@ -348,6 +350,7 @@ fn an_f32_tables_predicted_variance_is_that_of_its_stored_values() {
         params: vec![],
         seed: Some(3),
         optimized_for: "none".into(),
+        dimensions: None,
     };
     let sets = [set.clone()];
     let (f32_meta, _) = metadata(&sets, provenance(), TableFormat::F32, false).unwrap();
@@ -614,5 +617,58 @@ fn a_c_header_is_named_by_the_file_name_up_to_its_last_dot() {
             "{file}: {header}"
         );
     }
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+/// A padded 4D table says which dimensions are which half, and what drew
+/// each (fifth trial: a renderer author could not tell).
+#[test]
+fn padded_tables_name_their_halves() {
+    let d = dir("halves");
+    for (sampler, params, expected) in [
+        (
+            "padded",
+            vec!["--param", "xy=cmj", "--param", "uv=sobol"],
+            "dims 0, 1: (x, y) drawn by cmj; dims 2, 3: (u, v) drawn by sobol, independently",
+        ),
+        (
+            "umj",
+            vec![],
+            "dims 0, 1: (x, y) drawn by mj; dims 2, 3: (u, v) drawn by mj, independently",
+        ),
+    ] {
+        let out = d.join(format!("{sampler}.h"));
+        let mut args = vec!["tables", "--sampler", sampler, "-n", "16", "--sets", "1"];
+        args.extend(params);
+        args.extend(["-o", out.to_str().unwrap()]);
+        varspec(&args);
+        let header = std::fs::read_to_string(&out).unwrap();
+        assert!(header.contains(expected), "{sampler}: {header}");
+        let csv = d.join(format!("{sampler}.csv"));
+        args.pop();
+        args.push(csv.to_str().unwrap());
+        varspec(&args);
+        let meta = sidecar(&csv);
+        assert!(
+            meta.dimensions.as_deref().unwrap().starts_with(expected),
+            "{meta:?}"
+        );
+    }
+    // A sampler without halves says nothing.
+    let csv = d.join("sobol.csv");
+    varspec(&[
+        "tables",
+        "--sampler",
+        "sobol",
+        "-d",
+        "4",
+        "-n",
+        "16",
+        "--sets",
+        "1",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(sidecar(&csv).dimensions, None);
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -15,7 +15,7 @@ use varspec::io::write_atomic;
 use varspec::registry;
 use varspec::samplers;
 use varspec::tables::shard::{TableRun, TableShard, draw_shard, merge_table_shards};
-use varspec::tables::{PredictedVariances, Provenance, metadata, optimized_for};
+use varspec::tables::{PredictedVariances, Provenance, dimensions, metadata, optimized_for};
 
 #[derive(Clone, Copy, ValueEnum)]
 enum FormatArg {
@@ -158,6 +158,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     let provenance = Provenance {
         optimized_for: optimized_for(run_sampler.as_deref(), &run_params)?,
+        dimensions: dimensions(run_sampler.as_deref(), &run_params)?,
         source,
         params: run_params,
         seed: run_seed,

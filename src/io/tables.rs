@@ -64,6 +64,10 @@ pub struct TableMetadata {
     /// Predicted variance (shift-randomized estimator, spatial form, mean
     /// over the table's sets) on reference integrands.
     pub predicted_variance: Vec<(String, f64)>,
+    /// What a padded 4D table's dimensions are (dims 0, 1 the (x, y) half,
+    /// 2, 3 the (u, v) half, and the samplers of each); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dimensions: Option<String>,
     /// Why `predicted_variance` is empty, when it is (sets that are not
     /// 2D, or a cost over the budget); absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -281,6 +285,9 @@ fn write_c_header(
     )?;
     for (k, v) in &meta.params {
         writeln!(out, " * parameter {k}={v}")?;
+    }
+    if let Some(dims) = &meta.dimensions {
+        writeln!(out, " * {dims}")?;
     }
     for (spec, v) in &meta.predicted_variance {
         writeln!(out, " * predicted variance on {spec}: {v:e}")?;
