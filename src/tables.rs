@@ -124,20 +124,10 @@ pub fn dimensions(
     };
     let (name, params) = registry::split_spec(spec, params)?;
     let info = registry::find(name)?;
-    // The last value given wins, else the registry's default.
     let param = |key: &str| {
-        params
-            .iter()
-            .rev()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.clone())
-            .or_else(|| {
-                info.params
-                    .iter()
-                    .find(|p| p.key == key)
-                    .map(|p| p.default.to_string())
-            })
+        crate::samplers::config::param_or_default(&params, info.params, key)
             .unwrap_or_default()
+            .to_string()
     };
     let halves = match info.name {
         "umj" => {

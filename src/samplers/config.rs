@@ -82,18 +82,7 @@ impl Config {
     }
     /// The value of `key`, or its registered default.
     pub fn param(&self, key: &'static str) -> &str {
-        self.params
-            .iter()
-            .rev()
-            .find(|(k, _)| k == key)
-            .map(|(_, v)| v.as_str())
-            .or_else(|| {
-                self.defaults
-                    .iter()
-                    .find(|p| p.key == key)
-                    .map(|p| p.default)
-            })
-            .expect("parameter keys are registered")
+        param_or_default(&self.params, self.defaults, key).expect("parameter keys are registered")
     }
 
     /// The value of `key` if it was given.
@@ -149,6 +138,21 @@ pub(crate) fn integer_root(n: usize, d: usize) -> usize {
 /// `m^d`, saturating at `usize::MAX`.
 pub(crate) fn pow_saturating(m: usize, d: usize) -> usize {
     m.checked_pow(d as u32).unwrap_or(usize::MAX)
+}
+
+/// The value of `key` in `params` (the last given wins), or its default
+/// among `defaults`; `None` for a key that is neither.
+pub fn param_or_default<'a>(
+    params: &'a [(String, String)],
+    defaults: &'a [ParamInfo],
+    key: &str,
+) -> Option<&'a str> {
+    params
+        .iter()
+        .rev()
+        .find(|(k, _)| k == key)
+        .map(|(_, v)| v.as_str())
+        .or_else(|| defaults.iter().find(|p| p.key == key).map(|p| p.default))
 }
 
 #[cfg(test)]
