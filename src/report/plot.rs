@@ -393,18 +393,14 @@ pub fn power_png(
         }));
     }
     let zero = spectrum.freqs.zero_index();
-    let logs: Vec<f64> = spectrum
-        .power
-        .iter()
-        .enumerate()
-        .filter(|&(i, &p)| i != zero && p > 0.0)
-        .map(|(_, &p)| p.log10())
-        .collect();
-    let (lo, hi) = match min_max(logs.iter().copied()) {
-        (lo, hi) if hi > lo => (lo.max(hi - 4.0), hi),
-        (_, hi) if hi.is_finite() => (hi - 1.0, hi + 1.0),
-        _ => (-1.0, 1.0),
-    };
+    let (lo, hi) = power_colour_range(
+        spectrum
+            .power
+            .iter()
+            .enumerate()
+            .filter(|&(i, &p)| i != zero && p > 0.0)
+            .map(|(_, &p)| p.log10()),
+    );
     let side = spectrum.freqs.side();
     // Rows from the top: k_y from +h down to −h.
     let values: Vec<f64> = (0..side)
@@ -431,6 +427,19 @@ pub fn power_png(
         },
         path,
     )
+}
+
+/// The colour range of a power picture from the log10 powers at k ≠ 0:
+/// from the largest down at most four decades. A single value (an
+/// integrand with one frequency pair, e.g. a cosine) tops a one-decade
+/// range, so it reads as the peak it is and zeros (drawn at the bottom) as
+/// nothing; no positive power gives (−1, 1).
+fn power_colour_range(logs: impl Iterator<Item = f64>) -> (f64, f64) {
+    match min_max(logs) {
+        (lo, hi) if hi > lo => (lo.max(hi - 4.0), hi),
+        (_, hi) if hi.is_finite() => (hi - 1.0, hi),
+        _ => (-1.0, 1.0),
+    }
 }
 
 /// Writes `map` as a 760×640 PNG (viridis, colour bar on the right),
@@ -594,6 +603,23 @@ fn draw_heatmap_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn power_colour_range_ends_at_the_largest_power() {
+        // cos:kx=3,ky=5 has P_f = 1/4 at ±k and 0 elsewhere: the range ends
+        // at log10(1/4) (it was centred there, drawing the peak mid-scale).
+        let peak = 0.25f64.log10();
+        assert_eq!(
+            power_colour_range([peak, peak].into_iter()),
+            (peak - 1.0, peak)
+        );
+        // Six decades: the lowest two are clipped.
+        assert_eq!(
+            power_colour_range([-7.0, -3.0, -1.0].into_iter()),
+            (-5.0, -1.0)
+        );
+        assert_eq!(power_colour_range(std::iter::empty()), (-1.0, 1.0));
+    }
 
     #[test]
     fn tick_labels_are_tidy() {
