@@ -59,9 +59,8 @@ const LONG_DRAW: Duration = Duration::from_millis(500);
 
 /// Seconds one set of `sampler` takes to draw on one thread: the best of
 /// at least [`TIMED_DRAWS`] timings (two for a draw over [`LONG_DRAW`]),
-/// since warm-up (page faults, caches,
-/// the thread pool starting) and other processes' load only ever slow a
-/// draw down. `times` are the draws already made; draws shorter than
+/// since warm-up (page faults, caches, the thread pool starting) and other
+/// processes' load only ever slow a draw down. `times` are the draws already made; draws shorter than
 /// [`SHORTEST_TIMING`] are repeated in batches that last at least that
 /// long, so the clock's resolution and jitter do not count.
 fn draw_seconds(
@@ -70,8 +69,8 @@ fn draw_seconds(
     times: &[Duration],
 ) -> anyhow::Result<f64> {
     let fastest = times.iter().min().copied().unwrap_or(Duration::MAX);
-    let enough = if fastest >= LONG_DRAW { 2 } else { TIMED_DRAWS };
-    if fastest >= SHORTEST_TIMING && times.len() >= enough {
+    let long = !times.is_empty() && fastest >= LONG_DRAW;
+    if fastest >= SHORTEST_TIMING && times.len() >= if long { 2 } else { TIMED_DRAWS } {
         return Ok(fastest.as_secs_f64());
     }
     let batch = if fastest >= SHORTEST_TIMING {
@@ -80,12 +79,7 @@ fn draw_seconds(
         SHORTEST_TIMING.as_nanos() / fastest.as_nanos().max(1) + 1
     };
     let mut best = fastest.as_secs_f64();
-    let more = if fastest >= LONG_DRAW && fastest != Duration::MAX {
-        1
-    } else {
-        TIMED_DRAWS as u64
-    };
-    for timing in 0..more {
+    for timing in 0..if long { 1 } else { TIMED_DRAWS as u64 } {
         let start = Instant::now();
         for _ in 0..batch {
             sampler.sample(&mut set_rng(seed, timing))?;

@@ -79,7 +79,7 @@ pub fn best_lattice(n: usize, f: &dyn Integrand) -> Result<LatticeDesign, Optimi
         keep.into_iter().map(|i| all[i]).collect()
     };
     let ranked: Vec<(f64, f64)> = finalists
-        .iter()
+        .par_iter()
         .map(|l| lattice_variance(l, f).map(|v| (v.variance, v.rounding_bound)))
         .collect::<Result<_, _>>()?;
     let spread = |i: usize| finalists[i].spectral_test();

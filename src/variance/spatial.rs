@@ -64,9 +64,9 @@ const PROBE_TIMINGS: usize = 3;
 
 /// Seconds [`spatial`] would take here on every (N, sets) of `runs`, sets
 /// of `f`'s dimension: one set of min(largest N, 2048) random points is
-/// timed ([`PROBE_TIMINGS`] times, the fastest kept) and the time scaled by [`pair_evaluations`] (the cost is
-/// O(N²) per set, so a request can run for days; commands say so before
-/// they start).
+/// timed ([`PROBE_TIMINGS`] times, the fastest kept) and the time scaled
+/// by [`pair_evaluations`] (the cost is O(N²) per set, so a request can
+/// run for days; commands say so before they start).
 ///
 /// # Errors
 /// As [`spatial_variance`] (an integrand without c_f).
