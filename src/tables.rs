@@ -212,12 +212,7 @@ pub fn metadata(
     } else {
         Vec::new()
     };
-    let value_type = match format {
-        TableFormat::F32 => "f32 (float), little-endian",
-        TableFormat::CHeader => "f32 (float)",
-        TableFormat::F64 => "f64 (double), little-endian",
-        TableFormat::Csv | TableFormat::Json => "f64 as shortest round-trip decimal text",
-    };
+    let value_type = format.value_type();
     let predicted_variance_skipped = match status {
         PredictedVariances::Computed => None,
         PredictedVariances::NotTwoD => Some(format!(

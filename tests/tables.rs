@@ -6,9 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use varspec::PointSet;
-use varspec::io::tables::{
-    F32_PREV_ONE, TableFormat, TableMetadata, read_raw, to_unit_f32, write_table,
-};
+use varspec::io::tables::{F32_PREV_ONE, TableFormat, TableMetadata, to_unit_f32, write_table};
 use varspec::rng::PREV_ONE;
 
 /// A folder of the test `tag`'s own: tests run side by side, and one that
@@ -80,26 +78,24 @@ fn every_format_round_trips() {
         .flat_map(|s| s.coords().to_vec())
         .collect();
     assert_eq!(csv, values);
-    let f64s: Vec<f64> = read_raw(
-        &std::fs::read(out("f64")).unwrap(),
-        TableFormat::F64,
-        3,
-        32,
-        2,
-    )
-    .unwrap()
-    .concat();
+    // Raw files decoded here, independently of the reader.
+    let decode = |ext: &str, width: usize| -> Vec<f64> {
+        std::fs::read(out(ext))
+            .unwrap()
+            .chunks_exact(width)
+            .map(|c| {
+                if width == 4 {
+                    f64::from(f32::from_le_bytes(c.try_into().unwrap()))
+                } else {
+                    f64::from_le_bytes(c.try_into().unwrap())
+                }
+            })
+            .collect()
+    };
+    let f64s = decode("f64", 8);
     assert_eq!(f64s, values);
     // f32: the nearest f32, below 1.
-    let f32s: Vec<f64> = read_raw(
-        &std::fs::read(out("f32")).unwrap(),
-        TableFormat::F32,
-        3,
-        32,
-        2,
-    )
-    .unwrap()
-    .concat();
+    let f32s = decode("f32", 4);
     assert_eq!(f32s.len(), values.len());
     for (a, b) in f32s.iter().zip(&values) {
         assert_eq!(*a, f64::from(f32_at_or_below(*b)));
@@ -171,6 +167,26 @@ fn every_format_round_trips() {
         "cc -c failed: {}",
         String::from_utf8_lossy(&cc.stderr)
     );
+    // Every table reads back as point sets (raw ones through their
+    // sidecar): f64 formats to the bit, f32 ones to the values decoded
+    // above, with the sets' shape.
+    for (ext, expected) in [
+        ("csv", &values),
+        ("json", &values),
+        ("f64", &values),
+        ("f32", &f32s),
+        ("h", &f32s),
+    ] {
+        let back = varspec::io::read_point_sets(&out(ext))
+            .unwrap_or_else(|e| panic!("table.{ext} does not read back: {e}"));
+        assert_eq!(back.len(), 3, "table.{ext}");
+        assert!(
+            back.iter().all(|s| s.len() == 32 && s.dim() == 2),
+            "table.{ext}"
+        );
+        let read: Vec<f64> = back.iter().flat_map(|s| s.coords().to_vec()).collect();
+        assert_eq!(&read, expected, "table.{ext}");
+    }
     std::fs::remove_dir_all(&d).unwrap();
 }
 
@@ -194,13 +210,13 @@ fn f32_tables_stay_below_one() {
     };
     let mut bytes = Vec::new();
     write_table(&mut bytes, &[set], &meta, TableFormat::F32, "t").unwrap();
-    let values = read_raw(&bytes, TableFormat::F32, 1, 2, 2)
-        .unwrap()
-        .concat();
-    assert_eq!(values[0], F32_PREV_ONE as f64);
-    assert_eq!(values[2], F32_PREV_ONE as f64);
+    let values: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    assert_eq!(values[0], F32_PREV_ONE);
+    assert_eq!(values[2], F32_PREV_ONE);
     assert!(values.iter().all(|v| (0.0..1.0).contains(v)));
-    assert!(read_raw(&bytes[1..], TableFormat::F32, 1, 2, 2).is_err());
 }
 
 #[test]
@@ -670,5 +686,89 @@ fn padded_tables_name_their_halves() {
         csv.to_str().unwrap(),
     ]);
     assert_eq!(sidecar(&csv).dimensions, None);
+    std::fs::remove_dir_all(&d).unwrap();
+}
+
+#[test]
+fn tables_that_contradict_their_shape_are_refused_by_name() {
+    use crate::common::assert_fails;
+    let d = dir("refused");
+    let t = |name: &str| d.join(name).to_str().unwrap().to_owned();
+    for format in ["f32", "json", "c-header"] {
+        varspec(&[
+            "tables",
+            "--sampler",
+            "cmj",
+            "-n",
+            "16",
+            "--sets",
+            "2",
+            "--format",
+            format,
+            "-o",
+            &t(&format!("t.{format}")),
+        ]);
+    }
+    fn spectrum(file: &str) -> [&str; 6] {
+        ["spectrum", file, "--res", "4", "--csv", "/dev/null"]
+    }
+    // A raw table cut short: the sidecar's shape needs 256 bytes.
+    let raw = std::fs::read(t("t.f32")).unwrap();
+    std::fs::write(t("short.f32"), &raw[..100]).unwrap();
+    std::fs::copy(t("t.f32.json"), t("short.f32.json")).unwrap();
+    assert_fails(
+        &spectrum(&t("short.f32")),
+        "100 bytes, where its metadata's 2 sets x 16 points x 2 dimensions x 4 bytes need 256",
+    );
+    // The same bytes with no sidecar, and with one that is not metadata.
+    std::fs::write(t("bare.f32"), &raw).unwrap();
+    assert_fails(
+        &spectrum(&t("bare.f32")),
+        "read through its metadata sidecar",
+    );
+    std::fs::write(t("bad.f32"), &raw).unwrap();
+    std::fs::write(t("bad.f32.json"), "[1, 2]").unwrap();
+    assert_fails(&spectrum(&t("bad.f32")), "its sidecar is unreadable");
+    // The sidecar given in place of its table.
+    assert_fails(
+        &spectrum(&t("t.f32.json")),
+        "this is a table's metadata sidecar",
+    );
+    // A JSON table whose metadata says more sets than it holds.
+    let json = std::fs::read_to_string(t("t.json")).unwrap();
+    assert!(json.contains("\"sets\":2,"), "{json}");
+    std::fs::write(
+        t("more.json"),
+        json.replacen("\"sets\":2,", "\"sets\":3,", 1),
+    )
+    .unwrap();
+    assert_fails(
+        &spectrum(&t("more.json")),
+        "it holds 2 sets of 16 points in 2D, its metadata says 3 of 16 in 2D",
+    );
+    // Ragged points and a value of 1.
+    std::fs::write(t("ragged.json"), r#"{"sets": [[[0.1, 0.2], [0.3]]]}"#).unwrap();
+    assert_fails(
+        &spectrum(&t("ragged.json")),
+        "set 0, point 1 has 1 coordinate, where the first has 2",
+    );
+    std::fs::write(t("one.json"), r#"{"sets": [[[0.1, 1.0]]]}"#).unwrap();
+    assert_fails(
+        &spectrum(&t("one.json")),
+        "coordinate 1 is 1, outside [0, 1)",
+    );
+    // A C header with a point removed.
+    let header = std::fs::read_to_string(t("t.c-header")).unwrap();
+    let first_point = header.find("    {").unwrap();
+    let end = first_point + header[first_point..].find('\n').unwrap() + 1;
+    std::fs::write(
+        t("cut.h"),
+        format!("{}{}", &header[..first_point], &header[end..]),
+    )
+    .unwrap();
+    assert_fails(
+        &spectrum(&t("cut.h")),
+        "the array [2][16][2] holds 62 values",
+    );
     std::fs::remove_dir_all(&d).unwrap();
 }

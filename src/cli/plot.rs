@@ -17,7 +17,7 @@ pub enum PlotCommand {
 
 #[derive(clap::Args)]
 pub struct PointsArgs {
-    /// Point-set file (CSV, UTK text or .npy).
+    /// Point-set file (CSV, UTK text, .npy, or a table of `varspec tables`).
     file: PathBuf,
     /// The two dimensions to draw, horizontal then vertical (XU = 0,2; YV =
     /// 1,3); one dimension draws a strip of ticks (the default for 1D sets).

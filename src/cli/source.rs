@@ -15,7 +15,7 @@ use varspec::variance::VarianceError;
 
 #[derive(clap::Args)]
 pub struct SourceArgs {
-    /// Point-set file (CSV, UTK text or .npy); every set in it is used.
+    /// Point-set file (CSV, UTK text, .npy, or a table of `varspec tables`); every set in it is used.
     #[arg(conflicts_with_all = ["sampler", "points_flag"])]
     points: Option<PathBuf>,
     /// The same as the positional point-set file.

@@ -101,11 +101,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     // The metadata sidecar is an output too: `--from t.csv.json -o t.csv`
     // overwrote its own input.
-    let sidecar = format.needs_sidecar().then(|| {
-        let mut path = a.output.clone().into_os_string();
-        path.push(".json");
-        PathBuf::from(path)
-    });
+    let sidecar = format
+        .needs_sidecar()
+        .then(|| varspec::io::tables::sidecar_path(&a.output));
     super::args::check_outputs_beside(
         [Some(a.output.as_path()), sidecar.as_deref()],
         [a.from.as_deref()],

@@ -8,17 +8,24 @@
 //!   Ostromoukhov): whitespace-separated coordinates, one point per line, a
 //!   line starting with `#` between point sets.
 //!
+//! * **Pattern tables** of `varspec tables` (super::tables): JSON, C
+//!   headers, and raw f32/f64 read through their metadata sidecar.
+//!
 //! Readers detect the format from the first non-blank line (a CSV header
-//! starts with a letter). Values must be finite and in [0, 1); exactly 1.0 is
+//! starts with a letter, a JSON table with `{`, a C header table with
+//! [`tables::C_HEADER_START`]), from the `.npy` magic, or from a sidecar
+//! `PATH.json` whose layout names raw f32 or f64. Values must be finite and in [0, 1); exactly 1.0 is
 //! rejected (on the torus it is 0: write 0); `-0.0` reads as 0.
 
 use std::fmt;
 use std::fs::File;
-use std::io::{self, BufRead, BufReader, Write};
+use std::io::{self, BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 
+use super::bounded::BOM;
 use super::csv_rows::csv_io_error;
 use super::npy;
+use super::tables;
 use crate::points::PointSet;
 
 /// What is wrong with a point-set file, and where.
@@ -51,6 +58,14 @@ pub enum PointFileError {
     /// A NumPy `.npy` file that is not a point-set array.
     #[error("{path}: {problem}")]
     Npy {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A pattern table (`varspec tables`) that cannot be read back.
+    #[error("{path}: {problem}")]
+    Table {
         /// The file.
         path: PathBuf,
         /// What is wrong with it.
@@ -149,7 +164,11 @@ impl fmt::Display for LineProblem {
                 let fields = if *found == 1 { "field" } else { "fields" };
                 write!(f, "{found} {fields} where every row has {expected}")
             }
-            LineProblem::NotUtf8 => write!(f, "not UTF-8 text (is this a point-set file?)"),
+            LineProblem::NotUtf8 => write!(
+                f,
+                "not UTF-8 text (is this a point-set file? a raw f32 or f64 table is read through \
+                 its metadata sidecar, the file name with `.json` appended, beside it)"
+            ),
             LineProblem::SetNumber {
                 current: None,
                 text,
@@ -177,8 +196,10 @@ pub enum PointFormat {
     Utk,
 }
 
-/// Reads every point set in `path` (CSV, UTK text or NumPy `.npy`,
-/// detected from the content).
+/// Reads every point set in `path` (CSV, UTK text, NumPy `.npy`, or a
+/// pattern table of `varspec tables`: JSON, a C header, or raw f32/f64
+/// described by its sidecar `PATH.json`), detected from the content and the
+/// sidecar.
 ///
 /// # Errors
 /// [`PointFileError`] naming the file and, for malformed content, the line.
@@ -188,14 +209,56 @@ pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
         cause,
     };
     let file = File::open(path).map_err(io)?;
+    let len = file.metadata().map_err(io)?.len();
     let mut reader = BufReader::new(file);
-    if reader.fill_buf().map_err(io)?.starts_with(npy::MAGIC) {
+    let table = |problem| PointFileError::Table {
+        path: path.into(),
+        problem,
+    };
+    let sidecar = tables::read_sidecar(path);
+    if let Some(Ok(meta)) = &sidecar
+        && let Some(raw) = tables::raw_format(meta)
+    {
+        return tables::read_raw(reader, len, raw, meta).map_err(table);
+    }
+    let head = reader.fill_buf().map_err(io)?;
+    if head.starts_with(npy::MAGIC) {
         return npy::read_point_sets_npy(reader).map_err(|problem| PointFileError::Npy {
             path: path.into(),
             problem,
         });
     }
-    parse_point_sets(reader, path)
+    let bom = head.starts_with(BOM);
+    let text = head.strip_prefix(BOM).unwrap_or(head).trim_ascii_start();
+    let (json, c_header) = (
+        text.starts_with(b"{"),
+        text.starts_with(tables::C_HEADER_START.as_bytes()),
+    );
+    if json || c_header {
+        if bom {
+            reader.consume(BOM.len());
+        }
+        if json {
+            return tables::read_json_table(reader).map_err(table);
+        }
+        let mut text = String::new();
+        reader.read_to_string(&mut text).map_err(io)?;
+        return tables::read_c_header(&text).map_err(table);
+    }
+    parse_point_sets(reader, path).map_err(|e| match (e, sidecar) {
+        // Bytes that are not text beside a sidecar that is not a raw
+        // table's metadata: say what is wrong with the sidecar.
+        (
+            PointFileError::Line {
+                problem: LineProblem::NotUtf8,
+                ..
+            },
+            Some(Err(why)),
+        ) => table(format!(
+            "not UTF-8 text, and not a raw table: its sidecar is unreadable ({why})"
+        )),
+        (e, _) => e,
+    })
 }
 
 /// Reads `path` and checks that its points have dimension `dim`.

@@ -8,10 +8,15 @@
 //! rounded to nearest and, where that would give 1.0, replaced by the
 //! largest f32 below 1, so every entry stays in [0, 1).
 
-use std::io::{self, Write};
+use std::fmt;
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
+use serde::de::{DeserializeSeed, Error as _, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize};
 
+use super::bounded::read_text_bounded;
+use super::json::from_json;
 use super::pointfile::{PointFormat, write_point_sets};
 use crate::points::PointSet;
 
@@ -34,6 +39,17 @@ impl TableFormat {
     /// Whether the metadata goes to a `PATH.json` sidecar.
     pub fn needs_sidecar(self) -> bool {
         matches!(self, TableFormat::Csv | TableFormat::F32 | TableFormat::F64)
+    }
+
+    /// The value type the metadata's `layout` names (docs/formats.md);
+    /// the raw formats' say their byte order.
+    pub fn value_type(self) -> &'static str {
+        match self {
+            TableFormat::F32 => "f32 (float), little-endian",
+            TableFormat::CHeader => "f32 (float)",
+            TableFormat::F64 => "f64 (double), little-endian",
+            TableFormat::Csv | TableFormat::Json => "f64 as shortest round-trip decimal text",
+        }
     }
 }
 
@@ -335,45 +351,339 @@ fn c_float(v: f32) -> String {
     s
 }
 
-/// Reads raw little-endian tables back (for round trips and tools).
+/// The file holding a raw or CSV table's metadata: `PATH.json`.
+pub fn sidecar_path(table: &Path) -> PathBuf {
+    let mut path = table.as_os_str().to_owned();
+    path.push(".json");
+    PathBuf::from(path)
+}
+
+/// The metadata sidecar of `table`: `None` when there is no `PATH.json`
+/// (or it cannot be opened), `Some(Err)` saying why one that exists is not a
+/// table's metadata.
+pub fn read_sidecar(table: &Path) -> Option<Result<TableMetadata, String>> {
+    let path = sidecar_path(table);
+    if !path.is_file() {
+        return None;
+    }
+    let text = match read_text_bounded(&path, SIDECAR_LIMIT, "a table's metadata") {
+        Ok(text) => text,
+        Err(e) => return Some(Err(format!("{}: {e}", path.display()))),
+    };
+    Some(from_json(&text).map_err(|e| format!("{}: {e}", path.display())))
+}
+
+/// The largest sidecar read: 1 MiB (one is a few hundred bytes).
+const SIDECAR_LIMIT: u64 = 1 << 20;
+
+/// The raw format (`F32` or `F64`) a table's `layout` names, if any.
+pub fn raw_format(meta: &TableMetadata) -> Option<TableFormat> {
+    [TableFormat::F32, TableFormat::F64]
+        .into_iter()
+        .find(|f| meta.layout.contains(f.value_type()))
+}
+
+/// Reads a raw little-endian table (`format` `F32` or `F64`) of the shape
+/// `meta` gives, one set at a time (the file's bytes are never all held
+/// beside the values). `len` is the file's length in bytes, checked
+/// against the shape before anything is allocated.
 ///
 /// # Errors
-/// [`io::ErrorKind::InvalidData`] when the byte count does not match.
+/// A sentence: a shape that is empty or overflows, a length that does not
+/// match it, a read error, or a value outside [0, 1) (with its index).
 pub fn read_raw(
-    bytes: &[u8],
+    mut reader: impl Read,
+    len: u64,
     format: TableFormat,
-    sets: usize,
-    n: usize,
-    dim: usize,
-) -> io::Result<Vec<Vec<f64>>> {
-    let width = match format {
+    meta: &TableMetadata,
+) -> Result<Vec<PointSet>, String> {
+    let width: usize = match format {
         TableFormat::F32 => 4,
         TableFormat::F64 => 8,
-        _ => return Err(io::Error::other("only raw f32/f64 tables are read here")),
+        _ => return Err("only raw f32 and f64 tables are read here".into()),
     };
-    if bytes.len() != sets * n * dim * width {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidData,
-            format!(
-                "{} bytes, expected {} x {} x {} x {width}",
-                bytes.len(),
-                sets,
-                n,
-                dim
-            ),
+    let (sets, n, dim) = (meta.sets, meta.n, meta.dim);
+    if sets == 0 || n == 0 || dim == 0 {
+        return Err(format!(
+            "its metadata says {sets} sets of {n} points in {dim}D: a table holds at least one point"
         ));
     }
-    let values: Vec<f64> = bytes
-        .chunks_exact(width)
-        .map(|c| {
-            if width == 4 {
-                f32::from_le_bytes(c.try_into().expect("4 bytes")) as f64
-            } else {
-                f64::from_le_bytes(c.try_into().expect("8 bytes"))
-            }
+    let per_set = n.checked_mul(dim);
+    let expected = per_set
+        .and_then(|c| c.checked_mul(sets))
+        .and_then(|c| c.checked_mul(width))
+        .map(|c| c as u64);
+    if expected != Some(len) {
+        return Err(format!(
+            "{len} bytes, where its metadata's {sets} sets x {n} points x {dim} dimensions x \
+             {width} bytes need {}",
+            expected.map_or("more than 2^64".into(), |e| e.to_string())
+        ));
+    }
+    let per_set = per_set.expect("checked above");
+    let mut bytes = vec![0; per_set * width];
+    (0..sets)
+        .map(|s| {
+            reader
+                .read_exact(&mut bytes)
+                .map_err(|e| format!("set {s}: {e}"))?;
+            let coords = bytes
+                .chunks_exact(width)
+                .map(|c| {
+                    if width == 4 {
+                        f64::from(f32::from_le_bytes(c.try_into().expect("4 bytes")))
+                    } else {
+                        f64::from_le_bytes(c.try_into().expect("8 bytes"))
+                    }
+                })
+                .collect();
+            PointSet::new(dim, coords).map_err(|e| format!("set {s}: {e}"))
         })
+        .collect()
+}
+
+/// Reads a JSON table (`{"metadata": {...}, "sets": [...]}`) and checks
+/// its sets against its metadata. A hand-written file may leave the
+/// metadata out.
+///
+/// # Errors
+/// A sentence: serde_json's (with line and column), a set of another size
+/// or dimension than the others or the metadata say, a value outside
+/// [0, 1), or a table's sidecar given in place of the table.
+pub fn read_json_table(reader: impl Read) -> Result<Vec<PointSet>, String> {
+    let table: JsonTable =
+        serde_json::from_reader(reader).map_err(|e| format!("not a readable JSON table: {e}"))?;
+    let Some(JsonSets(sets)) = table.sets else {
+        return Err("a JSON table has `sets`: [[[x0, x1, ...], ...], ...] (and `metadata`)".into());
+    };
+    let Some(first) = sets.first() else {
+        return Err("its `sets` is empty".into());
+    };
+    if let Some(meta) = table.metadata {
+        let found = (sets.len(), first.len(), first.dim());
+        if found != (meta.sets, meta.n, meta.dim) {
+            return Err(format!(
+                "it holds {} sets of {} points in {}D, its metadata says {} of {} in {}D",
+                found.0, found.1, found.2, meta.sets, meta.n, meta.dim
+            ));
+        }
+    }
+    Ok(sets)
+}
+
+/// The top level of a JSON table.
+#[derive(Deserialize)]
+struct JsonTable {
+    metadata: Option<TableMetadata>,
+    sets: Option<JsonSets>,
+}
+
+/// A JSON table's `sets`, each read straight into one point-major vector
+/// (a vector per point would take three to four times the memory).
+struct JsonSets(Vec<PointSet>);
+
+impl<'de> Deserialize<'de> for JsonSets {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(SetsVisitor).map(JsonSets)
+    }
+}
+
+struct SetsVisitor;
+
+impl<'de> Visitor<'de> for SetsVisitor {
+    type Value = Vec<PointSet>;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("an array of sets, each an array of points")
+    }
+
+    /// `sets` a count: the metadata of a raw or CSV table, given in place
+    /// of the table.
+    fn visit_u64<E: serde::de::Error>(self, _: u64) -> Result<Self::Value, E> {
+        Err(E::custom(
+            "`sets` is a count: this is a table's metadata sidecar, which holds no points; give \
+             the table it describes (the same name without `.json`)",
+        ))
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+        let mut sets: Vec<PointSet> = Vec::new();
+        let mut shape = None;
+        while let Some((dim, coords)) = seq.next_element_seed(SetSeed {
+            set: sets.len(),
+            dim: shape.map(|(_, d)| d),
+        })? {
+            let s = sets.len();
+            let n = coords.len() / dim;
+            match shape {
+                None => shape = Some((n, dim)),
+                Some((n0, _)) if n != n0 => {
+                    return Err(A::Error::custom(format!(
+                        "set {s} holds {n} points, set 0 holds {n0}"
+                    )));
+                }
+                Some(_) => {}
+            }
+            sets.push(
+                PointSet::new(dim, coords)
+                    .map_err(|e| A::Error::custom(format!("set {s}: {e}")))?,
+            );
+        }
+        Ok(sets)
+    }
+}
+
+/// One set: its dimension (that of its first point, or `dim` when the
+/// sets before fixed it) and its coordinates.
+struct SetSeed {
+    set: usize,
+    dim: Option<usize>,
+}
+
+impl<'de> DeserializeSeed<'de> for SetSeed {
+    type Value = (usize, Vec<f64>);
+
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+        d.deserialize_seq(self)
+    }
+}
+
+impl<'de> Visitor<'de> for SetSeed {
+    type Value = (usize, Vec<f64>);
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "set {}: an array of points", self.set)
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Self::Value, A::Error> {
+        let mut coords = Vec::new();
+        let mut dim = self.dim;
+        let mut point = 0;
+        while let Some(found) = seq.next_element_seed(PointSeed(&mut coords))? {
+            match dim {
+                None if found > 0 => dim = Some(found),
+                Some(d) if d == found => {}
+                _ => {
+                    let coordinates = if found == 1 {
+                        "coordinate"
+                    } else {
+                        "coordinates"
+                    };
+                    return Err(A::Error::custom(format!(
+                        "set {}, point {point} has {found} {coordinates}, where {}",
+                        self.set,
+                        dim.map_or("a point has at least one".into(), |d| format!(
+                            "the first has {d}"
+                        ))
+                    )));
+                }
+            }
+            point += 1;
+        }
+        match dim {
+            Some(d) if point > 0 => Ok((d, coords)),
+            _ => Err(A::Error::custom(format!(
+                "set {} holds no points",
+                self.set
+            ))),
+        }
+    }
+}
+
+/// One point, appended to the set's coordinates; its value is the count of
+/// coordinates it had.
+struct PointSeed<'a>(&'a mut Vec<f64>);
+
+impl<'de> DeserializeSeed<'de> for PointSeed<'_> {
+    type Value = usize;
+
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
+        d.deserialize_seq(self)
+    }
+}
+
+impl<'de> Visitor<'de> for PointSeed<'_> {
+    type Value = usize;
+
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("a point: an array of numbers")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<usize, A::Error> {
+        let mut count = 0;
+        while let Some(v) = seq.next_element::<f64>()? {
+            self.0.push(v);
+            count += 1;
+        }
+        Ok(count)
+    }
+}
+
+/// The first words of a C header table.
+pub const C_HEADER_START: &str = "/* Generated by varspec";
+
+/// Reads a C header table back: the array `static const float
+/// NAME[SETS][N][DIM] = { ... };` its values exactly as the floats they
+/// declare (any layout of braces, commas and white space).
+///
+/// # Errors
+/// A sentence: no such array, a shape that is empty or overflows, a token
+/// that is not a float literal, a count of values other than the shape's,
+/// or a value outside [0, 1).
+pub fn read_c_header(text: &str) -> Result<Vec<PointSet>, String> {
+    const DECLARATION: &str = "static const float";
+    let missing = || format!("no `{DECLARATION} NAME[SETS][N][DIM] = {{ ... }};` array");
+    let start = text.find(DECLARATION).ok_or_else(missing)?;
+    let (head, body) = text[start..].split_once('=').ok_or_else(missing)?;
+    let shape: Vec<&str> = head
+        .split('[')
+        .skip(1)
+        .map(|p| p.split(']').next().unwrap_or_default().trim())
         .collect();
-    Ok(values.chunks(n * dim).map(<[f64]>::to_vec).collect())
+    let shape: Vec<usize> = match shape[..] {
+        [_, _, _] => shape
+            .iter()
+            .map(|t| t.parse::<usize>().ok().filter(|&v| v > 0))
+            .collect::<Option<_>>()
+            .ok_or_else(|| {
+                format!(
+                    "array shape [{}] is not three positive counts",
+                    shape.join("][")
+                )
+            })?,
+        _ => {
+            return Err(format!(
+                "the array has {} dimensions, a table's has 3 [SETS][N][DIM]",
+                shape.len()
+            ));
+        }
+    };
+    let (sets, n, dim) = (shape[0], shape[1], shape[2]);
+    let body = body.split("};").next().unwrap_or_default();
+    let mut values = Vec::new();
+    for token in body
+        .split(|c: char| c == '{' || c == '}' || c == ',' || c.is_whitespace())
+        .filter(|t| !t.is_empty())
+    {
+        let v: f32 = token
+            .strip_suffix(['f', 'F'])
+            .unwrap_or(token)
+            .parse()
+            .map_err(|_| format!("`{token}` in the array is not a float literal"))?;
+        values.push(f64::from(v));
+    }
+    let expected = sets.checked_mul(n).and_then(|c| c.checked_mul(dim));
+    if expected != Some(values.len()) {
+        return Err(format!(
+            "the array [{sets}][{n}][{dim}] holds {} values",
+            values.len()
+        ));
+    }
+    values
+        .chunks_exact(n * dim)
+        .enumerate()
+        .map(|(s, c)| PointSet::new(dim, c.to_vec()).map_err(|e| format!("set {s}: {e}")))
+        .collect()
 }
 
 #[cfg(test)]

@@ -13,6 +13,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use varspec::PointSet;
+use varspec::io::tables::TableFormat;
 use varspec::rng::{SetRng, below, set_rng};
 
 /// Tokens that break parsers.
@@ -242,7 +243,30 @@ fn scratch(tag: &str) -> std::path::PathBuf {
 pub fn targets() -> Vec<Target> {
     let set = PointSet::new(2, vec![0.1, 0.2, 0.3, 0.4, 0.5, 0.6]).unwrap();
     let mut npy = Vec::new();
-    varspec::io::npy::write_point_sets_npy(&mut npy, &[set.clone(), set]).unwrap();
+    varspec::io::npy::write_point_sets_npy(&mut npy, &[set.clone(), set.clone()]).unwrap();
+    let table = |format: TableFormat| {
+        let sets = [set.clone(), set.clone()];
+        let (meta, _) = varspec::tables::metadata(
+            &sets,
+            varspec::tables::Provenance {
+                source: "fuzz".into(),
+                params: vec![("m".into(), "4".into())],
+                seed: Some(3),
+                optimized_for: "none".into(),
+                dimensions: None,
+            },
+            format,
+            false,
+        )
+        .unwrap();
+        let mut bytes = Vec::new();
+        varspec::io::tables::write_table(&mut bytes, &sets, &meta, format, "fuzz").unwrap();
+        let sidecar = serde_json::to_vec_pretty(&meta).unwrap();
+        (bytes, sidecar)
+    };
+    let (json_table, _) = table(TableFormat::Json);
+    let (c_header, _) = table(TableFormat::CHeader);
+    let (_, sidecar) = table(TableFormat::F32);
     vec![
         Target {
             name: "integrand spec",
@@ -322,6 +346,23 @@ pub fn targets() -> Vec<Target> {
             run: Box::new(|b| {
                 varspec::io::pointfile::parse_point_sets(Cursor::new(b), Path::new("fuzz.csv"))
                     .is_ok()
+            }),
+        },
+        Target {
+            name: "pattern table (JSON)",
+            seeds: vec![json_table],
+            run: Box::new(|b| varspec::io::tables::read_json_table(Cursor::new(b)).is_ok()),
+        },
+        Target {
+            name: "pattern table (C header)",
+            seeds: vec![c_header],
+            run: Box::new(|b| varspec::io::tables::read_c_header(&text(b)).is_ok()),
+        },
+        Target {
+            name: "pattern table sidecar",
+            seeds: vec![sidecar],
+            run: Box::new(|b| {
+                varspec::io::from_json::<varspec::io::tables::TableMetadata>(&text(b)).is_ok()
             }),
         },
         Target {
