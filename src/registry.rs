@@ -484,7 +484,7 @@ mod tests {
         assert_eq!(
             e,
             SamplerError::Count {
-                sampler: "jitter",
+                sampler: "jitter".into(),
                 dim: 2,
                 n: 1000,
                 rule: "N = m^d",

@@ -772,3 +772,88 @@ fn tables_that_contradict_their_shape_are_refused_by_name() {
     );
     std::fs::remove_dir_all(&d).unwrap();
 }
+
+#[test]
+fn a_table_converted_from_a_table_keeps_its_provenance() {
+    let d = dir("provenance");
+    let t = |name: &str| d.join(name).to_str().unwrap().to_owned();
+    varspec(&[
+        "tables",
+        "--sampler",
+        "umj",
+        "-n",
+        "16",
+        "--sets",
+        "2",
+        "--seed",
+        "7",
+        "--format",
+        "f32",
+        "-o",
+        &t("u.f32"),
+    ]);
+    varspec(&[
+        "tables",
+        "--from",
+        &t("u.f32"),
+        "--format",
+        "json",
+        "-o",
+        &t("u.json"),
+    ]);
+    varspec(&[
+        "tables",
+        "--from",
+        &t("u.json"),
+        "--format",
+        "f64",
+        "-o",
+        &t("u.f64"),
+    ]);
+    let first = sidecar(Path::new(&t("u.f32")));
+    let last = sidecar(Path::new(&t("u.f64")));
+    assert_eq!(last.seed, Some(7));
+    assert_eq!(last.source, "umj");
+    assert_eq!(
+        (&last.params, &last.optimized_for, &last.dimensions),
+        (&first.params, &first.optimized_for, &first.dimensions)
+    );
+    assert!(last.layout.contains("f64 (double)"), "{}", last.layout);
+    // A CSV whose sidecar no longer describes it (a set removed by hand)
+    // is converted as a plain point file: no seed is claimed.
+    varspec(&[
+        "tables",
+        "--sampler",
+        "cmj",
+        "-n",
+        "4",
+        "--sets",
+        "2",
+        "--seed",
+        "3",
+        "--format",
+        "csv",
+        "-o",
+        &t("c.csv"),
+    ]);
+    let csv = std::fs::read_to_string(t("c.csv")).unwrap();
+    let one_set: String = csv
+        .lines()
+        .filter(|l| !l.starts_with("1,"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(t("c.csv"), one_set).unwrap();
+    varspec(&[
+        "tables",
+        "--from",
+        &t("c.csv"),
+        "--format",
+        "f64",
+        "-o",
+        &t("c.f64"),
+    ]);
+    let stale = sidecar(Path::new(&t("c.f64")));
+    assert_eq!((stale.seed, stale.sets), (None, 1));
+    assert_eq!(stale.source, t("c.csv"));
+    std::fs::remove_dir_all(&d).unwrap();
+}

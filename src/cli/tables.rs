@@ -8,7 +8,7 @@ use clap::ValueEnum;
 use super::args::DrawArgs;
 use super::progress;
 use varspec::experiment::Shard;
-use varspec::io::read_point_sets;
+use varspec::io::read_point_sets_with_metadata;
 use varspec::io::shards::{read_shard_files, shard_file_name};
 use varspec::io::tables::{TableFormat, write_table};
 use varspec::io::write_atomic;
@@ -111,6 +111,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut run_params = a.draw.params.clone();
     let mut run_seed = Some(a.draw.seed());
     let mut run_sampler = a.sampler.clone();
+    // A varspec table given to --from keeps the provenance its metadata
+    // records.
+    let mut carried = None;
     let (sets, source) = match (&a.sampler, &a.from) {
         _ if a.merge => {
             let shards = read_table_shards(&a.output)?;
@@ -150,16 +153,27 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 );
             }
             run_seed = None;
-            (read_point_sets(path)?, path.display().to_string())
+            let (sets, meta) = read_point_sets_with_metadata(path)?;
+            carried = meta;
+            (sets, path.display().to_string())
         }
         (None, None) => bail!("give --sampler or --from"),
     };
-    let provenance = Provenance {
-        optimized_for: optimized_for(run_sampler.as_deref(), &run_params)?,
-        dimensions: dimensions(run_sampler.as_deref(), &run_params)?,
-        source,
-        params: run_params,
-        seed: run_seed,
+    let provenance = match carried {
+        Some(m) => Provenance {
+            source: m.source,
+            params: m.params,
+            seed: m.seed,
+            optimized_for: m.optimized_for,
+            dimensions: m.dimensions,
+        },
+        None => Provenance {
+            optimized_for: optimized_for(run_sampler.as_deref(), &run_params)?,
+            dimensions: dimensions(run_sampler.as_deref(), &run_params)?,
+            source,
+            params: run_params,
+            seed: run_seed,
+        },
     };
     let (meta, predicted) = metadata(&sets, provenance, format, a.variance)?;
     // The metadata says why they are missing; a skipped cost is also said here.

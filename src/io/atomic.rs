@@ -242,7 +242,7 @@ where
     remove_stale_temporaries(&target);
     let tmp = temporary_sibling(&target);
     let result = (|| {
-        let file = File::create(&tmp)?;
+        let file = create_temporary(&tmp)?;
         let mut out = BufWriter::new(file);
         write(&mut out)?;
         let file = out.into_inner().map_err(|e| e.into_error())?;
@@ -308,7 +308,7 @@ pub fn check_output(path: &Path) -> Result<(), WriteError> {
         Ok(meta) if !meta.is_file() => probe_in_place(&target, &meta),
         _ => {
             let tmp = temporary_sibling(&target);
-            let created = File::create(&tmp).map(drop);
+            let created = create_temporary(&tmp).map(drop);
             let _ = fs::remove_file(&tmp);
             created
         }
@@ -467,6 +467,26 @@ fn remove_stale_temporaries(path: &Path) {
             let _ = fs::remove_file(entry.path());
         }
     }
+}
+
+/// Creates the temporary an output is written to before its rename; a
+/// refusal says so (in /proc, for one, an existing file can be opened but
+/// nothing created beside it, and the bare error was "No such file").
+fn create_temporary(tmp: &Path) -> io::Result<File> {
+    File::create(tmp).map_err(|e| {
+        let dir = match tmp.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        io::Error::new(
+            e.kind(),
+            format!(
+                "no file can be created in {} (an output is written to a temporary file beside \
+                 it, then renamed): {e}",
+                dir.display()
+            ),
+        )
+    })
 }
 
 fn temporary_sibling(path: &Path) -> PathBuf {

@@ -17,7 +17,8 @@ pub use bounded::{read_bounded, read_text_bounded};
 pub use csv_rows::write_csv_rows;
 pub use json::from_json;
 pub use pointfile::{
-    PointFileError, PointFormat, read_point_sets, read_point_sets_of_dim, write_point_sets,
+    PointFileError, PointFormat, read_point_sets, read_point_sets_of_dim,
+    read_point_sets_with_metadata, write_point_sets,
 };
 
 /// Writes point sets to `path` atomically, as NumPy `.npy` when its

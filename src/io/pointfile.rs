@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use super::bounded::BOM;
 use super::csv_rows::csv_io_error;
 use super::npy;
-use super::tables;
+use super::tables::{self, TableMetadata};
 use crate::points::PointSet;
 
 /// What is wrong with a point-set file, and where.
@@ -204,6 +204,19 @@ pub enum PointFormat {
 /// # Errors
 /// [`PointFileError`] naming the file and, for malformed content, the line.
 pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
+    read_point_sets_with_metadata(path).map(|(sets, _)| sets)
+}
+
+/// As [`read_point_sets`], with the metadata of a varspec table: a JSON
+/// table's own, or a sidecar `PATH.json` that describes the sets read (the
+/// same N, d and count; a stale one is left out). `None` for other files
+/// and for C headers (whose metadata is a comment).
+///
+/// # Errors
+/// As [`read_point_sets`].
+pub fn read_point_sets_with_metadata(
+    path: &Path,
+) -> Result<(Vec<PointSet>, Option<TableMetadata>), PointFileError> {
     let io = |cause| PointFileError::Io {
         path: path.into(),
         cause,
@@ -219,14 +232,25 @@ pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
     if let Some(Ok(meta)) = &sidecar
         && let Some(raw) = tables::raw_format(meta)
     {
-        return tables::read_raw(reader, len, raw, meta).map_err(table);
+        return tables::read_raw(reader, len, raw, meta)
+            .map(|sets| (sets, Some(meta.clone())))
+            .map_err(table);
     }
     let head = reader.fill_buf().map_err(io)?;
+    let described = |sets: Vec<PointSet>| {
+        let meta = match &sidecar {
+            Some(Ok(meta)) if tables::describes(meta, &sets) => Some(meta.clone()),
+            _ => None,
+        };
+        (sets, meta)
+    };
     if head.starts_with(npy::MAGIC) {
-        return npy::read_point_sets_npy(reader).map_err(|problem| PointFileError::Npy {
-            path: path.into(),
-            problem,
-        });
+        return npy::read_point_sets_npy(reader)
+            .map(described)
+            .map_err(|problem| PointFileError::Npy {
+                path: path.into(),
+                problem,
+            });
     }
     let bom = head.starts_with(BOM);
     let text = head.strip_prefix(BOM).unwrap_or(head).trim_ascii_start();
@@ -243,9 +267,11 @@ pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
         }
         let mut text = String::new();
         reader.read_to_string(&mut text).map_err(io)?;
-        return tables::read_c_header(&text).map_err(table);
+        return tables::read_c_header(&text)
+            .map(|sets| (sets, None))
+            .map_err(table);
     }
-    parse_point_sets(reader, path).map_err(|e| match (e, sidecar) {
+    let sets = parse_point_sets(reader, path).map_err(|e| match (e, &sidecar) {
         // Bytes that are not text beside a sidecar that is not a raw
         // table's metadata: say what is wrong with the sidecar.
         (
@@ -258,7 +284,8 @@ pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
             "not UTF-8 text, and not a raw table: its sidecar is unreadable ({why})"
         )),
         (e, _) => e,
-    })
+    })?;
+    Ok(described(sets))
 }
 
 /// Reads `path` and checks that its points have dimension `dim`.

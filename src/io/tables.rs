@@ -450,7 +450,9 @@ pub fn read_raw(
 /// A sentence: serde_json's (with line and column), a set of another size
 /// or dimension than the others or the metadata say, a value outside
 /// [0, 1), or a table's sidecar given in place of the table.
-pub fn read_json_table(reader: impl Read) -> Result<Vec<PointSet>, String> {
+pub fn read_json_table(
+    reader: impl Read,
+) -> Result<(Vec<PointSet>, Option<TableMetadata>), String> {
     let table: JsonTable =
         serde_json::from_reader(reader).map_err(|e| format!("not a readable JSON table: {e}"))?;
     let Some(JsonSets(sets)) = table.sets else {
@@ -459,16 +461,28 @@ pub fn read_json_table(reader: impl Read) -> Result<Vec<PointSet>, String> {
     let Some(first) = sets.first() else {
         return Err("its `sets` is empty".into());
     };
-    if let Some(meta) = table.metadata {
-        let found = (sets.len(), first.len(), first.dim());
-        if found != (meta.sets, meta.n, meta.dim) {
-            return Err(format!(
-                "it holds {} sets of {} points in {}D, its metadata says {} of {} in {}D",
-                found.0, found.1, found.2, meta.sets, meta.n, meta.dim
-            ));
-        }
+    if let Some(meta) = &table.metadata
+        && !describes(meta, &sets)
+    {
+        return Err(format!(
+            "it holds {} sets of {} points in {}D, its metadata says {} of {} in {}D",
+            sets.len(),
+            first.len(),
+            first.dim(),
+            meta.sets,
+            meta.n,
+            meta.dim
+        ));
     }
-    Ok(sets)
+    Ok((sets, table.metadata))
+}
+
+/// Whether `meta` has the shape of `sets` (its N, d and count).
+pub fn describes(meta: &TableMetadata, sets: &[PointSet]) -> bool {
+    sets.len() == meta.sets
+        && sets
+            .iter()
+            .all(|s| s.len() == meta.n && s.dim() == meta.dim)
 }
 
 /// The top level of a JSON table.

@@ -112,7 +112,7 @@ impl Config {
         above: Option<usize>,
     ) -> SamplerError {
         SamplerError::Count {
-            sampler: self.sampler,
+            sampler: self.sampler.to_string(),
             dim: self.dim,
             n: self.n,
             rule,

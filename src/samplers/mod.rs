@@ -121,8 +121,8 @@ pub enum SamplerError {
     /// N does not fit the sampler's structure.
     #[error("{sampler} in {dim}D: N = {n} does not fit ({rule}); nearest valid N: {}", nearest(*below, *above))]
     Count {
-        /// Sampler name.
-        sampler: &'static str,
+        /// Sampler name (for a padded set's half, which half of what).
+        sampler: String,
         /// The dimension the set was asked in (the rule often depends on it).
         dim: usize,
         /// Requested N.

@@ -14,7 +14,8 @@ pub struct RadialBin {
     pub k: usize,
     /// Mean power over the ring.
     pub power: f64,
-    /// Sample variance of the power over the ring / mean².
+    /// Sample variance of the power over the ring / mean²; 0 on a ring of
+    /// zero power (powers are ≥ 0, so a zero mean is a constant ring).
     pub anisotropy: f64,
     /// Frequencies in the ring.
     pub count: usize,
