@@ -8,6 +8,9 @@
 //! ```sh
 //! cargo run --profile fuzz --example fuzz_parsers -- results/fuzz 1000000
 //! ```
+//!
+//! A fourth argument runs only the parsers whose name contains it
+//! (`-- out 1000000 1592651810 "pattern table"`).
 
 #[path = "../tests/common/fuzz.rs"]
 mod fuzz;
@@ -21,6 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = args.first().cloned().unwrap_or_else(|| "out/fuzz".into());
     let count: u64 = args.get(1).map_or(Ok(1_000_000), |a| a.parse())?;
     let seed: u64 = args.get(2).map_or(Ok(0x5eed_f022), |a| a.parse())?;
+    let only = args.get(3).cloned().unwrap_or_default();
     std::fs::create_dir_all(&out)?;
     std::panic::set_hook(Box::new(|_| {}));
     let mut csv = csv::Writer::from_path(format!("{out}/fuzz.csv"))?;
@@ -36,7 +40,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("| parser | inputs | accepted | panics | slower than 1 s | slowest | wall time |");
     println!("|---|---|---|---|---|---|---|");
     let mut failed = false;
-    for target in fuzz::targets() {
+    for target in fuzz::targets()
+        .into_iter()
+        .filter(|t| t.name.contains(&only))
+    {
         let start = Instant::now();
         const CHUNK: u64 = 10_000;
         let tally = (0..count.div_ceil(CHUNK))

@@ -122,7 +122,10 @@ fn damaged_checkpoints_and_those_of_another_run_are_refused() {
 #[test]
 fn a_killed_descent_continues_from_its_checkpoint_to_the_same_set() {
     let dir = common::temp_dir("checkpoint-kill");
+    // Coarse-to-fine, so the resumed run's report must carry the coarse
+    // phase it did not run again.
     let args = |out: &str| -> Vec<String> {
+        let report = format!("{out}.json");
         [
             "optimize",
             "points",
@@ -136,8 +139,11 @@ fn a_killed_descent_continues_from_its_checkpoint_to_the_same_set() {
             "0",
             "--sets",
             "1",
+            "--coarse",
             "-o",
             out,
+            "--report",
+            &report,
         ]
         .iter()
         .map(|s| s.to_string())
@@ -197,4 +203,17 @@ fn a_killed_descent_continues_from_its_checkpoint_to_the_same_set() {
         !ckpt.exists(),
         "the checkpoint was not removed after the output was written"
     );
+    let report = |csv: &std::path::Path| {
+        common::read_json(&std::path::PathBuf::from(format!("{}.json", csv.display())))
+    };
+    let (whole, resumed) = (report(&whole), report(&resumed));
+    assert!(
+        whole["coarse_iterations"][0].as_u64().unwrap() > 0,
+        "no coarse phase: nothing was tested"
+    );
+    assert_eq!(
+        resumed["coarse_iterations"], whole["coarse_iterations"],
+        "the resumed report lost the coarse phase"
+    );
+    assert_eq!(resumed["iterations"], whole["iterations"]);
 }

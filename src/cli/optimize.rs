@@ -9,6 +9,7 @@ use clap::Subcommand;
 use serde_json::json;
 
 use super::{args, progress};
+use varspec::baseline::CLASSIC;
 use varspec::design::torus::{TorusPlan, TorusRequest, results_bytes};
 use varspec::io::write_atomic;
 use varspec::optimize::adapted::{
@@ -361,8 +362,26 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
         every: std::time::Duration::from_secs_f64(a.checkpoint_every),
         on_event: &on_event,
     });
-    let design = plan.run(&|_, _| bar.inc(1), checkpoint.as_ref())?;
-    bar.finish_and_clear();
+    // The classic samplers' exact variances come after the descent: the
+    // bar ends with it, and a long comparison is said before it starts.
+    let estimate = std::cell::Cell::new(None);
+    let on_designed = || {
+        bar.finish_and_clear();
+        match plan.comparison_estimate() {
+            Ok(Some(s)) if s > LONG_COMPARISON => eprintln!(
+                "comparing with {} classic samplers x {} sets by the exact variance (spatial form, O(N^2) per set): about {}",
+                CLASSIC.len(),
+                a.sets.max(8),
+                progress::duration_words(std::time::Duration::from_secs_f64(s))
+            ),
+            Ok(_) => {}
+            Err(e) => estimate.set(Some(e)),
+        }
+    };
+    let design = plan.run(&|_, _| bar.inc(1), checkpoint.as_ref(), &on_designed)?;
+    if let Some(e) = estimate.into_inner() {
+        return Err(e.into());
+    }
     varspec::io::write_point_file(&a.output, &design.points)?;
     if let Some(path) = &a.checkpoint {
         for (file, e) in remove_checkpoints(path, a.sets) {
@@ -374,14 +393,16 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
         _ => String::new(),
     };
     outln!(
-        "{} set(s) of {} points for {} in {:.2} s ({coarse}{} iterations for set 0, {}); loss {:.4e}",
+        "{} set(s) of {} points for {} in {:.2} s ({coarse}{} iteration{} for set 0, {}); loss {:.4e}; compared with the classic samplers in {:.2} s",
         a.sets,
         a.n,
         a.target,
         design.run.seconds,
         design.iterations[0],
+        if design.iterations[0] == 1 { "" } else { "s" },
         design.stopped[0].describe(),
-        design.mean_loss
+        design.mean_loss,
+        design.comparison_seconds
     );
     if let Some(v) = design.exact_variance {
         if v <= design.rounding {
@@ -415,8 +436,9 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
             .map(|e| format!("  exact variance {e:.4e}"))
             .unwrap_or_default();
         outln!(
-            "  {name:<14} loss {:.4e}{exact}",
-            v["loss"].as_f64().unwrap_or(f64::NAN)
+            "  {name:<14} loss {:.4e}{exact}{}",
+            v["loss"].as_f64().unwrap_or(f64::NAN),
+            other_n(v, a.n)
         );
     }
     let baselines: Vec<(&str, f64)> = design.baselines.iter().map(|b| (b.name, b.score)).collect();
@@ -478,6 +500,22 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     )
 }
 
+/// A note for a comparison row whose sampler drew another N than the
+/// design's (the nearest its structure allows: jitter's m^d), empty
+/// otherwise: its scores are not at equal N.
+fn other_n(row: &serde_json::Value, n: usize) -> String {
+    match row["n"].as_u64() {
+        Some(m) if m != n as u64 => {
+            format!("  (at N = {m}, the nearest N it draws: not at equal N)")
+        }
+        _ => String::new(),
+    }
+}
+
+/// A comparison with the classic samplers estimated longer than this many
+/// seconds is said before it starts.
+const LONG_COMPARISON: f64 = 10.0;
+
 /// The family members a square design is scored on without --members.
 const DEFAULT_SCORE_MEMBERS: usize = 1024;
 /// The seed of those members without --score-seed.
@@ -536,10 +574,11 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
             })
             .collect();
         outln!(
-            "  {name:<14}{mses}  closest pair {:.3}",
+            "  {name:<14}{mses}  closest pair {:.3}{}",
             v["closest_pair_over_hexagonal"]
                 .as_f64()
-                .unwrap_or(f64::NAN)
+                .unwrap_or(f64::NAN),
+            other_n(v, a.n)
         );
     }
     design_outputs(

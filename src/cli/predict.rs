@@ -677,7 +677,8 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
     out.insert("sets".into(), json!(sets.len()));
     out.insert(
         "brute_force".into(),
-        json!({"mse": brute.mse, "stderr": brute.stderr, "ci_low": brute.interval_95().0,
+        json!({"mse": brute.mse, "stderr": brute.stderr, "stderr_members": brute.stderr_members,
+               "stderr_sets": brute.stderr_sets, "ci_low": brute.interval_95().0,
                "ci_high": brute.interval_95().1, "members": brute.members, "member_seed": seed,
                "seconds": start.elapsed().as_secs_f64()}),
     );

@@ -157,7 +157,8 @@ pub fn design_on_square(
             let s = family_mse(sets, f, r.members, r.score_seed);
             m.insert(
                 f.spec(),
-                json!({"mse": s.mse, "stderr": s.stderr, "members": s.members}),
+                json!({"mse": s.mse, "stderr": s.stderr, "stderr_members": s.stderr_members,
+                       "stderr_sets": s.stderr_sets, "members": s.members, "sets": sets.len()}),
             );
         }
         let closest = sets

@@ -11,7 +11,7 @@ use serde::Serialize;
 use serde_json::json;
 
 use super::DesignRun;
-use crate::baseline::{Baseline, classic_baselines};
+use crate::baseline::{Baseline, CLASSIC, classic_baselines};
 use crate::integrands::Integrand;
 use crate::optimize::adapted::{CheckpointPlan, Kept, design_sets};
 use crate::optimize::lattice::{LatticeDesign, best_lattice};
@@ -22,6 +22,7 @@ use crate::samplers::{Sampler, SamplerError};
 use crate::spectrum::Upsampling;
 use crate::spectrum::nufft::nufft_memory_bytes;
 use crate::sum::mean;
+use crate::variance::spatial::{estimated_seconds, pair_evaluations};
 use crate::variance::spatial_variance;
 
 /// What to design (the options of `optimize points` on the torus).
@@ -105,6 +106,8 @@ pub struct TorusDesign {
     /// Mean best loss of the designs and of each classic sampler
     /// (`{"optimized": {"n", "loss"}, "jitter": {...}, ...}`).
     pub comparison: serde_json::Map<String, serde_json::Value>,
+    /// Wall time of that comparison (after the design's `seconds`).
+    pub comparison_seconds: f64,
     /// Mean exact variance (spatial form, no box) where the target is an
     /// integrand with a closed-form autocovariance.
     pub exact_variance: Option<f64>,
@@ -267,6 +270,25 @@ impl TorusPlan {
         &self.optimizer
     }
 
+    /// Seconds the classic samplers' exact variances would take (the
+    /// spatial form on 8 or more sets of each of [`CLASSIC`] at N), when
+    /// the target has an exact form and the pairs exceed 2^30 (below, a few
+    /// seconds at most: `None`).
+    ///
+    /// # Errors
+    /// As [`estimated_seconds`].
+    pub fn comparison_estimate(&self) -> Result<Option<f64>, OptimizeError> {
+        let r = &self.request;
+        let Some(f) = self.exact_form.as_deref().filter(|f| f.dim() == r.dim) else {
+            return Ok(None);
+        };
+        let sets = r.sets.max(8) * CLASSIC.len();
+        if pair_evaluations(f, r.n) * sets as f64 <= (1u64 << 30) as f64 {
+            return Ok(None);
+        }
+        Ok(Some(estimated_seconds(f, &[(r.n, sets)])?))
+    }
+
     /// Iterations per set at most.
     pub fn iters(&self) -> usize {
         self.iters
@@ -292,8 +314,10 @@ impl TorusPlan {
         )
     }
 
-    /// Designs the sets (`on_iteration(set, loss)` after every step) and
-    /// scores them and 8 or more sets of each classic sampler by the loss.
+    /// Designs the sets (`on_iteration(set, loss)` after every step), calls
+    /// `on_designed`, and scores them and 8 or more sets of each classic
+    /// sampler by the loss (and by the exact variance where the target has
+    /// one: O(N²) per set, [`TorusPlan::comparison_estimate`]).
     ///
     /// # Errors
     /// [`OptimizeError`] from a start, a checkpoint or a baseline.
@@ -301,6 +325,7 @@ impl TorusPlan {
         &self,
         on_iteration: &(dyn Fn(usize, f64) + Sync),
         checkpoint: Option<&CheckpointPlan>,
+        on_designed: &dyn Fn(),
     ) -> Result<TorusDesign, OptimizeError> {
         let r = &self.request;
         let start = std::time::Instant::now();
@@ -314,6 +339,8 @@ impl TorusPlan {
             checkpoint,
         )?;
         let seconds = self.prepare_seconds + start.elapsed().as_secs_f64();
+        on_designed();
+        let comparing = std::time::Instant::now();
         let final_losses: Vec<f64> = results
             .iter()
             .map(|k| {
@@ -361,6 +388,7 @@ impl TorusPlan {
         ) {
             entry.insert("exact_variance".into(), json!(mean(v)));
         }
+        let comparison_seconds = comparing.elapsed().as_secs_f64();
         let half = self.optimizer.frequencies().half;
         Ok(TorusDesign {
             points: results.iter().map(|k| k.points.clone()).collect(),
@@ -385,6 +413,7 @@ impl TorusPlan {
             loss_curve: results[0].descent.losses.clone(),
             loss_curve_seconds: results[0].descent.seconds.clone(),
             comparison,
+            comparison_seconds,
             exact_variance: exact.as_deref().map(mean),
             exact: results
                 .iter()

@@ -164,6 +164,9 @@ pub struct AdamState {
     pub seconds: Vec<f64>,
     /// Wall time spent before the first entry (a coarse phase), in seconds.
     pub seconds_offset: f64,
+    /// Iterations of the coarse phase run before this state's first step
+    /// (0: none), kept across restarts for the report.
+    pub coarse_iterations: usize,
 }
 
 impl AdamState {
@@ -186,6 +189,7 @@ impl AdamState {
             losses: Vec::new(),
             seconds: Vec::new(),
             seconds_offset: 0.0,
+            coarse_iterations: 0,
         }
     }
 
@@ -328,7 +332,7 @@ pub fn adam_from(
         seconds: s.seconds,
         best_score: s.best_score,
         start_score: s.start_score,
-        coarse_iterations: 0,
+        coarse_iterations: s.coarse_iterations,
         stop,
     }
 }

@@ -31,6 +31,9 @@ struct Header {
     since_reset: i32,
     scores: usize,
     losses: usize,
+    /// Absent in checkpoints written before it was kept (read as 0).
+    #[serde(default)]
+    coarse_iterations: usize,
 }
 
 /// What stops a checkpoint from being read.
@@ -82,6 +85,7 @@ pub fn save(path: &Path, run: &str, state: &AdamState) -> Result<(), WriteError>
         since_reset: state.since_reset,
         scores: state.scores.len(),
         losses: state.losses.len(),
+        coarse_iterations: state.coarse_iterations,
     };
     write_atomic_now(path, |w| {
         writeln!(w, "{MAGIC}")?;
@@ -197,5 +201,6 @@ pub fn load(path: &Path, run: &str) -> Result<Option<AdamState>, CheckpointError
         losses,
         seconds,
         seconds_offset: 0.0,
+        coarse_iterations: h.coarse_iterations,
     }))
 }

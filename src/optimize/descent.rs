@@ -355,7 +355,7 @@ impl PointOptimizer {
         checkpointing: Option<&Checkpointing>,
     ) -> DescentResult {
         let o = &self.options;
-        let (state, coarse) = match &self.coarse {
+        let state = match &self.coarse {
             Some(coarse) if state.t == 0 => {
                 let clock = std::time::Instant::now();
                 let start =
@@ -363,9 +363,10 @@ impl PointOptimizer {
                 let first = coarse.optimize(start, &|_, _| {});
                 let mut fine = AdamState::start(&first.points);
                 fine.seconds_offset = clock.elapsed().as_secs_f64();
-                (fine, first.losses.len())
+                fine.coarse_iterations = first.losses.len();
+                fine
             }
-            _ => (state, 0),
+            _ => state,
         };
         let step = if self.coarse.is_some() {
             o.step / 5.0
@@ -384,16 +385,14 @@ impl PointOptimizer {
             optimizer: self,
             work: std::sync::Mutex::new(self.work(state.len())),
         };
-        let mut result = adam_from(
+        adam_from(
             state,
             &objective,
             &adam_options,
             Domain::Torus,
             on_iteration,
             checkpointing,
-        );
-        result.coarse_iterations = coarse;
-        result
+        )
     }
 }
 
