@@ -217,3 +217,48 @@ fn a_killed_descent_continues_from_its_checkpoint_to_the_same_set() {
     );
     assert_eq!(resumed["iterations"], whole["iterations"]);
 }
+
+#[test]
+fn checkpoints_of_a_run_with_another_set_count_are_named() {
+    let dir = common::temp_dir("checkpoint-stray");
+    let base = dir.join("run.ckpt");
+    for stray in ["run.ckpt.0", "run.ckpt.1", "run.ckpt.x"] {
+        std::fs::write(dir.join(stray), b"").unwrap();
+    }
+    let out = dir.join("x.csv");
+    let run = common::varspec_ok(&[
+        "optimize",
+        "points",
+        "-n",
+        "64",
+        "--target",
+        "family:disks",
+        "--sets",
+        "1",
+        "--iters",
+        "5",
+        "--checkpoint",
+        base.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&run.stderr);
+    let (zero, one) = (dir.join("run.ckpt.0"), dir.join("run.ckpt.1"));
+    assert!(
+        said.contains(&format!(
+            "{}, {} are checkpoints of a run with another --sets",
+            zero.display(),
+            one.display()
+        )),
+        "{said}"
+    );
+    assert!(
+        !said.contains("run.ckpt.x"),
+        "not a checkpoint name: {said}"
+    );
+    assert!(
+        zero.exists() && one.exists(),
+        "another run's files are left alone"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

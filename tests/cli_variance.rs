@@ -166,6 +166,53 @@ fn predict_judges_sheared_sets_by_the_estimator_they_were_built_for() {
 }
 
 #[test]
+fn with_a_file_the_seed_draws_the_empirical_shifts() {
+    let dir = common::temp_dir("predict-shift-seed");
+    let file = dir.join("c8.csv");
+    let file = file.to_str().unwrap();
+    varspec_ok(&["sample", "cmj", "-n", "64", "--sets", "8", "-o", file]);
+    let empirical = |seed: Option<&str>| {
+        let mut args = vec![
+            "predict",
+            file,
+            "--integrand",
+            "disk:r=0.3",
+            "--method",
+            "empirical",
+            "--realizations",
+            "2000",
+            "--json",
+        ];
+        if let Some(s) = seed {
+            args.extend(["--seed", s]);
+        }
+        json(&args)["empirical"]["variance"].as_f64().unwrap()
+    };
+    let default = empirical(None);
+    assert_eq!(empirical(Some("0")), default, "--seed 0 is the default");
+    let (a, b) = (empirical(Some("5")), empirical(Some("6")));
+    assert!(
+        a != default && b != a,
+        "new seeds, new shifts: {default} {a} {b}"
+    );
+    // Nothing else is random with a file: there --seed is still refused.
+    common::assert_fails(
+        &[
+            "predict",
+            file,
+            "--integrand",
+            "disk:r=0.3",
+            "--method",
+            "spatial",
+            "--seed",
+            "5",
+        ],
+        "a seed would change nothing",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn predict_output_does_not_depend_on_thread_count() {
     // A fixed --sets, and white noise's automatic count (a pilot of 16,
     // then more: variance::sets).

@@ -160,7 +160,7 @@ fn optimize_points_reports_the_lattice_start() {
             "-o",
             out.to_str().unwrap(),
         ],
-        "--init lattice needs a 2D integrand target",
+        "needs a 2D integrand target with a closed-form autocovariance (cos, disk, box, gaussian, halfplane); to start from one given rank-1 lattice, name it: --init lattice:g=G",
     );
 }
 

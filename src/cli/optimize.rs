@@ -13,7 +13,7 @@ use varspec::baseline::CLASSIC;
 use varspec::design::torus::{TorusPlan, TorusRequest, results_bytes};
 use varspec::io::write_atomic;
 use varspec::optimize::adapted::{
-    CheckpointEvent, CheckpointPlan, checkpoint_path, remove_checkpoints,
+    CheckpointEvent, CheckpointPlan, checkpoint_path, remove_checkpoints, stray_checkpoints,
 };
 use varspec::registry;
 use varspec::spectrum::Upsampling;
@@ -150,7 +150,8 @@ pub struct PointsArgs {
     /// Torus, 2D blue-noise targets: one phase on the full box, whatever N
     #[arg(long)]
     no_coarse: bool,
-    /// Torus designs: save the descent's whole state here while it runs
+    /// Torus designs toward one target (not 4D projection or square
+    /// designs): save the descent's whole state here while it runs
     /// (set r of several in PATH.r); a run given the same path continues
     /// from it, with the same result as a run never stopped, and removes it
     /// once the output is written.
@@ -356,6 +357,32 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
             });
         }
     };
+    if let Some(path) = &a.checkpoint {
+        let stray = stray_checkpoints(path, a.sets);
+        if !stray.is_empty() {
+            let names: Vec<String> = stray.iter().map(|p| p.display().to_string()).collect();
+            eprintln!(
+                "note: {} {} of a run with another --sets: this run of {} reads and removes only {}; \
+                 the others stay",
+                names.join(", "),
+                if names.len() == 1 {
+                    "is a checkpoint"
+                } else {
+                    "are checkpoints"
+                },
+                super::stdout::counted(a.sets, "set"),
+                if a.sets == 1 {
+                    path.display().to_string()
+                } else {
+                    format!(
+                        "{} to {}",
+                        checkpoint_path(path, 0, a.sets).display(),
+                        checkpoint_path(path, a.sets - 1, a.sets).display()
+                    )
+                }
+            );
+        }
+    }
     let checkpoint = a.checkpoint.as_deref().map(|path| CheckpointPlan {
         path,
         run: &run,
@@ -479,10 +506,11 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     );
     for t in &design.terms {
         outln!(
-            "  {:<40} loss {:.4e} -> {:.4e}",
+            "  {:<40} loss {:.4e} -> {:.4e}  (box |k| <= {} on its plane)",
             t.term,
             t.loss_before,
-            t.loss_after
+            t.loss_after,
+            t.half
         );
     }
     let closest = design.closest_pair_over_hexagonal;

@@ -188,7 +188,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.realizations.is_some() && !(asks(MethodArg::Empirical) || asks(MethodArg::All)) {
         bail!("--realizations applies to the empirical predictor (--method empirical or all)");
     }
-    let mut source = a.source.resolve(Some(f.dim()))?;
+    // With a file, --seed seeds the empirical predictor's shifts (its one
+    // random draw), so a user can redraw them; other predictors use
+    // nothing random from a file, so there it is refused.
+    let empirical_runs = pixel || asks(MethodArg::Empirical) || asks(MethodArg::All);
+    let mut source = if empirical_runs {
+        a.source.resolve_seeded(Some(f.dim()))?
+    } else {
+        a.source.resolve(Some(f.dim()))?
+    };
+    let shift_seed = match source {
+        varspec::source::Source::File { .. } => DEFAULT_SHIFT_SEED ^ a.source.seed(),
+        _ => DEFAULT_SHIFT_SEED,
+    };
     let sets = source.count();
     // A render averages f over each pixel's set as it is drawn: a pixel's
     // variance is that of the unshifted estimator.
@@ -382,16 +394,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         let shifted = shift.dims(f.dim());
         // Each realization is fetched once, as its estimate starts.
         let bar = progress::bar(realizations as u64, "empirical form, realizations");
-        let e = empirical_shifting(
-            f.as_ref(),
-            realizations,
-            DEFAULT_SHIFT_SEED,
-            &shifted,
-            |r| {
-                bar.inc(1);
-                source.get_cyclic(r).map_err(|e| realization_error(r, e))
-            },
-        );
+        let e = empirical_shifting(f.as_ref(), realizations, shift_seed, &shifted, |r| {
+            bar.inc(1);
+            source.get_cyclic(r).map_err(|e| realization_error(r, e))
+        });
         bar.finish_and_clear();
         let e = e?;
         out.insert(

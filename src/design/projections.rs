@@ -44,6 +44,9 @@ pub struct TermLoss {
     pub weight: f64,
     /// The 2×4 projection.
     pub rows: [[f64; 4]; 2],
+    /// Half-width h of the term's frequency box |k|∞ ≤ h on its plane (its
+    /// 2D target's default box at N): the loss sees no frequency beyond.
+    pub half: usize,
     /// Mean loss of the starts.
     pub loss_before: f64,
     /// Mean loss of the designs.
@@ -132,6 +135,7 @@ pub fn design_projections(
             term: term.label.clone(),
             weight: term.weight,
             rows: term.rows,
+            half: term.half(),
             loss_before: mean(results.iter().map(|x| x.0[t]).collect()),
             loss_after: mean(points.iter().map(|s| term.loss(s)).collect()),
         })

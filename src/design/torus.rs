@@ -18,6 +18,7 @@ use crate::optimize::lattice::{LatticeDesign, best_lattice};
 use crate::optimize::{DescentOptions, OptimizeError, PointOptimizer, Stop, Target};
 use crate::points::PointSet;
 use crate::registry;
+use crate::samplers::lattice::MAX_POINTS as LATTICE_MAX_POINTS;
 use crate::samplers::{Sampler, SamplerError};
 use crate::spectrum::Upsampling;
 use crate::spectrum::nufft::nufft_memory_bytes;
@@ -159,7 +160,9 @@ impl TorusPlan {
         let exact_form = integrand.filter(|f| f.has_autocov());
         let init_name = r.init.clone().unwrap_or_else(|| {
             match &exact_form {
-                Some(f) if r.dim == 2 && f.dim() == 2 => "lattice",
+                // The lattice search holds up to MAX_POINTS points; beyond,
+                // the default is the next best start.
+                Some(f) if r.dim == 2 && f.dim() == 2 && r.n <= LATTICE_MAX_POINTS => "lattice",
                 _ if has_integrand && r.dim == 2 => "cmj",
                 _ => "random",
             }
@@ -203,8 +206,10 @@ impl TorusPlan {
         let (init, lattice): (Box<dyn Sampler>, _) = if init_name == "lattice" {
             let Some(f) = exact_form.as_ref().filter(|f| f.dim() == 2 && r.dim == 2) else {
                 return Err(OptimizeError::Option(
-                    "--init lattice needs a 2D integrand target with a closed-form autocovariance \
-                     (cos, disk, box, gaussian, halfplane)"
+                    "--init lattice (the search for the best integration lattice) needs a 2D \
+                     integrand target with a closed-form autocovariance (cos, disk, box, gaussian, \
+                     halfplane); to start from one given rank-1 lattice, name it: --init \
+                     lattice:g=G"
                         .into(),
                 ));
             };

@@ -175,6 +175,39 @@ pub fn checkpoint_path(path: &Path, set: usize, sets: usize) -> PathBuf {
     PathBuf::from(name)
 }
 
+/// Checkpoint files beside `path` that a run with another set count wrote
+/// (`PATH` of one set, `PATH.r` of several) and a run of `sets` sets does
+/// not read, sorted: a run resumed with another `--sets` starts afresh, and
+/// says so.
+pub fn stray_checkpoints(path: &Path, sets: usize) -> Vec<PathBuf> {
+    let ours: Vec<PathBuf> = (0..sets).map(|r| checkpoint_path(path, r, sets)).collect();
+    let Some(name) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+        return Vec::new();
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut stray: Vec<PathBuf> = entries
+        .flatten()
+        .filter(|e| {
+            let file = e.file_name().to_string_lossy().into_owned();
+            file == name
+                || file
+                    .strip_prefix(&name)
+                    .and_then(|r| r.strip_prefix('.'))
+                    .is_some_and(|r| !r.is_empty() && r.bytes().all(|b| b.is_ascii_digit()))
+        })
+        .map(|e| path.with_file_name(e.file_name()))
+        .filter(|p| !ours.contains(p))
+        .collect();
+    stray.sort();
+    stray
+}
+
 /// Removes the checkpoint files of `sets` sets with base path `path` (once
 /// the designs are written); returns those that could not be removed, with
 /// why. Files already gone are not failures.

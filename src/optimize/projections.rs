@@ -60,6 +60,11 @@ impl ProjectionTerm {
     pub fn loss(&self, points: &PointSet) -> f64 {
         self.optimizer.loss(&self.project(points))
     }
+
+    /// Half-width of the term's frequency box on its plane.
+    pub fn half(&self) -> usize {
+        self.optimizer.frequencies().half
+    }
 }
 
 /// Whether `spec` is a projection target rather than a plain one.
