@@ -53,7 +53,7 @@ pub struct ShearArgs {
     /// Fresh realizations of the independent before/after check (0: skip it).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 4000)]
     realizations: usize,
-    /// Write the sheared sets here (CSV).
+    /// Write the sheared sets here (point-set CSV; NumPy .npy when the name ends in .npy).
     #[arg(short = 'o', long = "output")]
     output: Option<PathBuf>,
     /// Write XU and YV projection spectra before and after as PREFIX-{xu,yv}-{before,after}.png.
@@ -120,7 +120,8 @@ pub struct PointsArgs {
     /// Stop when the loss improves by less than this, relatively, over 50
     /// iterations (default 1e-3 for blue-noise targets: the same variance on
     /// unseen disks and boxes as 1e-4 in half the time; 1e-4 for integrand
-    /// and projection targets; 0: never).
+    /// and projection targets; 0: never). Not for --domain square, whose
+    /// stochastic descent runs its --iters (2000) to the cap.
     #[arg(long)]
     rel_tol: Option<f64>,
     /// The non-uniform FFT's upsampling factor σ: the fine grid has σ times
@@ -129,7 +130,7 @@ pub struct PointsArgs {
     /// for this N (1.25 below about 200,000 points in 2D).
     #[arg(long, value_enum, default_value_t = UpsamplingArg::Auto)]
     upsampling: UpsamplingArg,
-    /// Output point-set file (CSV).
+    /// Output point-set file (CSV; NumPy .npy when the name ends in .npy).
     #[arg(short = 'o', long = "output")]
     output: PathBuf,
     /// JSON report: loss curve, wall time, loss beside the classic samplers.
@@ -586,7 +587,15 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
         a.target,
         design.run.seconds,
         design.run.init,
-        design.stopped[0].describe(),
+        match design.stopped[0] {
+            // The stochastic descent has no stopping test: the cap is its
+            // length, not a failure to converge.
+            varspec::optimize::Stop::Cap => format!(
+                "its {} iterations (a fixed-length stochastic descent)",
+                design.max_iterations
+            ),
+            other => other.describe().to_string(),
+        },
         members,
         score_seed
     );
