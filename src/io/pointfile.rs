@@ -14,8 +14,9 @@
 //! Readers detect the format from the first non-blank line (a CSV header
 //! starts with a letter, a JSON table with `{`, a C header table with
 //! [`tables::C_HEADER_START`]), from the `.npy` magic, or from a sidecar
-//! `PATH.json` whose layout names raw f32 or f64. Values must be finite and in [0, 1); exactly 1.0 is
-//! rejected (on the torus it is 0: write 0); `-0.0` reads as 0.
+//! `PATH.json` whose layout names raw f32 or f64. Values must be finite and
+//! in [0, 1); exactly 1.0 is rejected (on the torus it is 0: write 0);
+//! `-0.0` reads as 0.
 
 use std::fmt;
 use std::fs::File;
