@@ -85,7 +85,25 @@ pub fn parse_projections(spec: &str, n: usize) -> Result<Vec<ProjectionTerm>, Op
         reason,
     };
     let mut terms = Vec::new();
-    for part in spec.split(';').map(str::trim).filter(|p| !p.is_empty()) {
+    let parts: Vec<&str> = spec.split(';').map(str::trim).collect();
+    for (i, &part) in parts.iter().enumerate() {
+        if part.is_empty() {
+            // One trailing `;` marks a lone term as a projection target
+            // (`'defocus:…;'`); any other empty term is a typing slip.
+            if i > 0 && i == parts.len() - 1 {
+                continue;
+            }
+            return Err(fail(format!(
+                "term {} of {} is empty (a leading `;` or `;;`): remove it",
+                i + 1,
+                parts.len()
+            )));
+        }
+        if parts[..i].contains(&part) {
+            return Err(fail(format!(
+                "`{part}` is given twice: write one term with a weight (2*TERM) instead"
+            )));
+        }
         let (weight, part) = match part.split_once('*') {
             Some((w, rest)) if w.trim().parse::<f64>().is_ok() => {
                 let w: f64 = w.trim().parse().expect("checked");
