@@ -921,15 +921,24 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
             }
         );
         if let Some((before, after)) = check {
+            // An interval with no upper end (every estimate equal) is said
+            // so, as the JSON's null does.
+            let upper = |v: f64| {
+                if v.is_finite() {
+                    format!("{v:.4e}")
+                } else {
+                    "no upper end".into()
+                }
+            };
             outln!(
-                "check on {} fresh sets: {:.4e} [{:.4e}, {:.4e}] -> {:.4e} [{:.4e}, {:.4e}]{}",
+                "check on {} fresh sets: {:.4e} [{:.4e}, {}] -> {:.4e} [{:.4e}, {}]{}",
                 after.realizations,
                 before.variance,
                 before.ci_low,
-                before.ci_high,
+                upper(before.ci_high),
                 after.variance,
                 after.ci_low,
-                after.ci_high,
+                upper(after.ci_high),
                 run.ratio.map_or(String::new(), |r| format!(
                     "; paired ratio {:.3} [{:.3}, {:.3}]",
                     r.ratio, r.ci_low, r.ci_high
