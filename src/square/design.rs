@@ -84,18 +84,20 @@ pub fn parse_target(spec: &str) -> Result<Vec<SquareTerm>, FamilyError> {
             ),
             None => (1.0, part),
         };
-        if family.trim() == "blue" {
-            terms.push(SquareTerm {
-                kind: TermKind::Blue,
-                weight,
-            });
-            continue;
+        let kind = if family.trim() == "blue" {
+            TermKind::Blue
+        } else {
+            TermKind::Family(Family::parse(family.trim())?)
+        };
+        // Twice the same term is one term of twice the weight: say so
+        // rather than read a slip silently.
+        if terms.iter().any(|t: &SquareTerm| t.kind == kind) {
+            return Err(fail(format!(
+                "`{}` is given twice: write one term with a weight (2*TERM) instead",
+                family.trim()
+            )));
         }
-        let family = Family::parse(family.trim())?;
-        terms.push(SquareTerm {
-            kind: TermKind::Family(family),
-            weight,
-        });
+        terms.push(SquareTerm { kind, weight });
     }
     Ok(terms)
 }
