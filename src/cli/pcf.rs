@@ -9,7 +9,7 @@ use super::source::SourceArgs;
 use varspec::io::{write_atomic, write_csv_rows};
 use varspec::neighbours::packing_radius_at_density;
 use varspec::report::plot::{LinePlot, Series, line_plot_png};
-use varspec::spectrum::pcf::{kernel_evaluations, pair_correlation};
+use varspec::spectrum::pcf::{KERNEL_REACH, kernel_evaluations, pair_correlation};
 
 /// Kernel evaluations above which pcf says before it starts that it will
 /// take long: 3e9 took about 20 s on 2 busy cores (4 cmj sets of 1024
@@ -82,7 +82,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // distances alias): say so in the units the options are given in.
     // The default shrinks to fit (to 99% of the largest range that does),
     // saying so; a range given is kept or refused.
-    let largest = 0.5 / unit - 6.0 * a.bandwidth;
+    let largest = 0.5 / unit - KERNEL_REACH * a.bandwidth;
     if given.is_none() && range >= largest && 0.99 * largest >= a.bandwidth {
         range = 0.99 * largest;
         eprintln!(
@@ -112,9 +112,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if work > LONG_WORK {
         eprintln!(
             "note: about {work:.1e} kernel evaluations (pairs within reach x the bins within \
-             6 bandwidths of each): this may take a long time; fewer --bins (the kernel spans \
-             {:.0} of them) or a smaller --bandwidth make it faster",
-            (12.0 * a.bandwidth / (range / a.bins as f64)).min(a.bins as f64)
+             {KERNEL_REACH} bandwidths of each): this may take a long time; fewer --bins (the \
+             kernel spans {:.0} of them) or a smaller --bandwidth make it faster",
+            (2.0 * KERNEL_REACH * a.bandwidth / (range / a.bins as f64)).min(a.bins as f64)
         );
     }
     let pcf = pair_correlation(&sets, range * unit, a.bins, a.bandwidth * unit)?;

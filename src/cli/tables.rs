@@ -251,10 +251,7 @@ fn draw_table_shard(a: &Args, shard: Shard) -> anyhow::Result<()> {
 
 /// Every OUTPUT.shard-i-of-n.json beside `output`.
 fn read_table_shards(output: &std::path::Path) -> anyhow::Result<Vec<TableShard>> {
-    let folder = match output.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => std::path::Path::new("."),
-    };
+    let folder = varspec::io::folder_of(output);
     let file = output
         .file_name()
         .context("--merge needs -o naming the table file")?;

@@ -424,10 +424,7 @@ fn rename_durably(tmp: &Path, target: &Path) -> io::Result<()> {
     tests::JOURNAL.with(|j| j.borrow_mut().push(format!("rename {}", target.display())));
     #[cfg(unix)]
     {
-        let dir = match target.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => Path::new("."),
-        };
+        let dir = folder_of(target);
         File::open(dir)?.sync_all()?;
         #[cfg(test)]
         tests::JOURNAL.with(|j| j.borrow_mut().push(format!("sync {}", dir.display())));
@@ -447,10 +444,7 @@ fn remove_stale_temporaries(path: &Path) {
         return;
     };
     let prefix = format!(".{name}.tmp-");
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
+    let dir = folder_of(path);
     let Ok(entries) = fs::read_dir(dir) else {
         return;
     };
@@ -469,21 +463,25 @@ fn remove_stale_temporaries(path: &Path) {
     }
 }
 
+/// The folder holding `path`: its parent, or `.` for a bare file name.
+pub fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
 /// Creates the temporary an output is written to before its rename; a
 /// refusal says so (in /proc, for one, an existing file can be opened but
 /// nothing created beside it, and the bare error was "No such file").
 fn create_temporary(tmp: &Path) -> io::Result<File> {
     File::create(tmp).map_err(|e| {
-        let dir = match tmp.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d,
-            _ => Path::new("."),
-        };
         io::Error::new(
             e.kind(),
             format!(
                 "no file can be created in {} (an output is written to a temporary file beside \
                  it, then renamed): {e}",
-                dir.display()
+                folder_of(tmp).display()
             ),
         )
     })

@@ -10,8 +10,8 @@ pub mod shards;
 pub mod tables;
 
 pub use atomic::{
-    WriteError, all_or_nothing, check_output, file_identity, is_standard_output, read_output,
-    write_atomic, write_atomic_now, write_staged_devices,
+    WriteError, all_or_nothing, check_output, file_identity, folder_of, is_standard_output,
+    read_output, write_atomic, write_atomic_now, write_staged_devices,
 };
 pub use bounded::{read_bounded, read_text_bounded};
 pub use csv_rows::write_csv_rows;

@@ -184,11 +184,7 @@ pub fn stray_checkpoints(path: &Path, sets: usize) -> Vec<PathBuf> {
     let Some(name) = path.file_name().map(|n| n.to_string_lossy().into_owned()) else {
         return Vec::new();
     };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let Ok(entries) = std::fs::read_dir(dir) else {
+    let Ok(entries) = std::fs::read_dir(crate::io::folder_of(path)) else {
         return Vec::new();
     };
     let mut stray: Vec<PathBuf> = entries

@@ -64,23 +64,11 @@ pub(crate) fn padded_from_config(c: &Config) -> Result<Box<dyn Sampler>, Sampler
             return Err(c.bad_param(key, "a 2D sampler (see varspec sample --list)"));
         }
         // A half's count rule is the padded sampler's: say which half.
-        c.build_other(name, c.n, Some(2), &[]).map_err(|e| match e {
-            SamplerError::Count {
-                sampler,
-                dim,
-                n,
-                rule,
-                below,
-                above,
-            } => SamplerError::Count {
-                sampler: format!("{}'s {key} half, {sampler},", c.sampler),
-                dim,
-                n,
-                rule,
-                below,
-                above,
-            },
-            other => other,
+        c.build_other(name, c.n, Some(2), &[]).map_err(|mut e| {
+            if let SamplerError::Count { sampler, .. } = &mut e {
+                *sampler = format!("{}'s {key} half, {sampler},", c.sampler);
+            }
+            e
         })
     };
     Ok(Box::new(Padded::new(half("xy")?, half("uv")?)?))

@@ -66,6 +66,11 @@ fn smoothed_radius_power(d: usize, r: f64, sigma: f64) -> f64 {
     }
 }
 
+/// The Gaussian kernel's reach in bandwidths: a pair adds to the radii
+/// within ±`KERNEL_REACH`·σ of its distance (beyond, e^(−18) < 2e-8 of the
+/// peak).
+pub const KERNEL_REACH: f64 = 6.0;
+
 /// The kernel evaluations [`pair_correlation`] makes, expected for
 /// uniformly spread points: each set's N(N − 1) ordered pairs, at distance
 /// ρ with density S_d·ρ^(d−1) (S_d the unit sphere's surface), times the
@@ -81,13 +86,14 @@ pub fn kernel_evaluations(sets: &[PointSet], r_end: f64, bins: usize, bandwidth:
         return 0.0;
     };
     const STEPS: usize = 256;
-    let reach = r_end + 6.0 * bandwidth;
+    let reach = r_end + KERNEL_REACH * bandwidth;
     let step = r_end / bins as f64;
     let h = reach / STEPS as f64;
     let per_pair: f64 = (0..STEPS)
         .map(|k| {
             let rho = (k as f64 + 0.5) * h;
-            let span = (rho + 6.0 * bandwidth).min(r_end) - (rho - 6.0 * bandwidth).max(0.0);
+            let span = (rho + KERNEL_REACH * bandwidth).min(r_end)
+                - (rho - KERNEL_REACH * bandwidth).max(0.0);
             unit_sphere_surface(d) * rho.powi(d as i32 - 1) * h * (span / step).max(0.0)
         })
         .sum();
@@ -123,9 +129,9 @@ pub fn pair_correlation(
             "bandwidth {bandwidth}, range {r_end} and bins {bins} must be positive"
         ));
     }
-    if r_end + 6.0 * bandwidth >= 0.5 {
+    if r_end + KERNEL_REACH * bandwidth >= 0.5 {
         return fail(format!(
-            "range {r_end} + 6 x bandwidth {bandwidth} reaches 1/2: toroidal distances alias there"
+            "range {r_end} + {KERNEL_REACH} x bandwidth {bandwidth} reaches 1/2: toroidal distances alias there"
         ));
     }
     if let Some(s) = sets.iter().find(|s| s.len() < 2 || s.dim() != d) {
@@ -143,7 +149,7 @@ pub fn pair_correlation(
     )?;
     let r: Vec<f64> = (1..=bins).map(|b| r_end * b as f64 / bins as f64).collect();
     let step = r_end / bins as f64;
-    let reach = r_end + 6.0 * bandwidth;
+    let reach = r_end + KERNEL_REACH * bandwidth;
     let norm = 1.0 / ((2.0 * std::f64::consts::PI).sqrt() * bandwidth);
     let per_set: Vec<Vec<f64>> = sets
         .par_iter()
@@ -155,9 +161,10 @@ pub fn pair_correlation(
                 grid.for_each_within(i, reach, |_, d2| {
                     let dist = d2.sqrt();
                     // Only radii within 6σ of the pair's distance get weight.
-                    let lo =
-                        (((dist - 6.0 * bandwidth) / step).ceil() as isize - 1).max(0) as usize;
-                    let hi = ((((dist + 6.0 * bandwidth) / step).floor() as isize).max(0) as usize)
+                    let lo = (((dist - KERNEL_REACH * bandwidth) / step).ceil() as isize - 1).max(0)
+                        as usize;
+                    let hi = ((((dist + KERNEL_REACH * bandwidth) / step).floor() as isize).max(0)
+                        as usize)
                         .min(bins);
                     for (a, &rb) in acc[lo.min(hi)..hi].iter_mut().zip(&r[lo.min(hi)..hi]) {
                         let z = (rb - dist) / bandwidth;
