@@ -9,7 +9,7 @@ use super::progress;
 use super::source::SourceArgs;
 use varspec::integrands::Integrand;
 use varspec::io::npy::write_npy;
-use varspec::io::{write_atomic, write_csv_rows};
+use varspec::io::{write_atomic, write_csv_headed, write_csv_rows};
 use varspec::report::plot::{LinePlot, Series, line_plot_png, power_png};
 use varspec::scene::pixel::PixelIntegrand;
 use varspec::spectrum::expected::check_memory;
@@ -45,7 +45,8 @@ pub struct Args {
     /// Relative tolerance of the fast method (1e-14 to 0.1; default 1e-9).
     #[arg(value_parser = super::args::tolerance, long, allow_hyphen_values = true)]
     tol: Option<f64>,
-    /// CSV of the spectrum: kx,ky,power.
+    /// CSV of the spectrum: kx,ky,power (a projection's axes: kx,ku,power
+    /// for --dims 0,2).
     #[arg(long)]
     csv: Option<PathBuf>,
     /// NumPy float64 array [S, S] of the spectrum, S = 2h + 1 with h the
@@ -189,23 +190,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         )
     };
     if let Some(path) = &a.csv {
-        #[derive(serde::Serialize)]
-        struct PowerRow {
-            kx: i64,
-            ky: i64,
-            power: f64,
-        }
         write_atomic(path, |w| {
             let mut k = [0i64; 2];
-            write_csv_rows(
+            write_csv_headed(
                 w,
+                &[axes[0], axes[1], "power"],
                 spectrum.power.iter().enumerate().map(|(idx, &power)| {
                     freqs.frequency(idx, &mut k);
-                    PowerRow {
-                        kx: k[0],
-                        ky: k[1],
-                        power,
-                    }
+                    (k[0], k[1], power)
                 }),
             )
         })?;

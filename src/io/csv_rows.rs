@@ -22,6 +22,27 @@ pub fn write_csv_rows<R: Serialize>(
     w.flush()
 }
 
+/// Writes `header`, then `rows` (tuples or sequences, one value per column):
+/// for tables whose column names depend on the data, such as a projection's
+/// frequency axes (kx, ku for the XU plane).
+///
+/// # Errors
+/// The I/O error of writing, or a record serde cannot write as one row.
+pub fn write_csv_headed<R: Serialize>(
+    out: &mut dyn Write,
+    header: &[&str],
+    rows: impl IntoIterator<Item = R>,
+) -> io::Result<()> {
+    let mut w = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(out);
+    w.write_record(header).map_err(csv_io_error)?;
+    for row in rows {
+        w.serialize(row).map_err(csv_io_error)?;
+    }
+    w.flush()
+}
+
 /// The I/O error under a `csv` error, its kind kept (a closed pipe stays
 /// `BrokenPipe`, which the command line treats as success), or the error
 /// as `InvalidData` when it is not one of I/O (a malformed record read, a

@@ -14,7 +14,7 @@ pub use atomic::{
     read_output, write_atomic, write_atomic_now, write_staged_devices,
 };
 pub use bounded::{read_bounded, read_text_bounded};
-pub use csv_rows::write_csv_rows;
+pub use csv_rows::{write_csv_headed, write_csv_rows};
 pub use json::from_json;
 pub use pointfile::{
     PointFileError, PointFormat, read_point_sets, read_point_sets_of_dim,
