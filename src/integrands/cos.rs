@@ -76,6 +76,18 @@ impl Integrand for Cosine {
         })
     }
 
+    fn autocov_between(&self, x: &[f64], y: &[f64]) -> Option<f64> {
+        // Each point's phase k₀·x mod 1 is exact to rounding; their
+        // difference is the phase of x − y without the rounding of x − y.
+        let phase = |p: &[f64]| reduced_phase(self.k0[0], p[0]) + reduced_phase(self.k0[1], p[1]);
+        let t = phase(x) - phase(y);
+        Some(if self.constant() {
+            0.0
+        } else {
+            0.5 * (std::f64::consts::TAU * (t - t.round())).cos()
+        })
+    }
+
     fn class(&self) -> IntegrandClass {
         IntegrandClass {
             smooth: true,

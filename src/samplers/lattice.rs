@@ -46,11 +46,27 @@ impl Lattice {
 
     /// Point `j` (j < N), exact in binary fractions of N.
     pub fn point(&self, j: usize) -> [f64; 2] {
+        let ([x, y], [p, q]) = self.fractions(j);
+        [x as f64 / p as f64, y as f64 / q as f64]
+    }
+
+    /// Point `j` as the rounded coordinates of [`Lattice::point`] and their
+    /// rounding remainders: p/q = hi + lo to about 2⁻¹⁰⁶ (the remainder
+    /// p − hi·q is exact by one fused multiply-add, Dekker 1971).
+    pub fn point_split(&self, j: usize) -> ([f64; 2], [f64; 2]) {
+        let (num, den) = self.fractions(j);
+        let hi = [0, 1].map(|k| num[k] as f64 / den[k] as f64);
+        let lo = [0, 1].map(|k| (-hi[k]).mul_add(den[k] as f64, num[k] as f64) / den[k] as f64);
+        (hi, lo)
+    }
+
+    /// Point `j`'s coordinates as fractions: numerators and denominators.
+    fn fractions(&self, j: usize) -> ([usize; 2], [usize; 2]) {
         let n = self.len();
         let (i, m) = (j % self.a, j / self.a);
         // (m·a − b·i) mod N without overflow or negative values.
         let y = ((m * self.a) % n + n - (self.b * i) % n) % n;
-        [i as f64 / self.a as f64, y as f64 / n as f64]
+        ([i, y], [self.a, n])
     }
 
     /// Its points moved by `shift` (mod 1): one realization of the randomly

@@ -137,12 +137,8 @@ pub fn spatial_variance(points: &PointSet, f: &dyn Integrand) -> Result<(f64, f6
         });
     }
     let pair = |i: usize, j: usize| {
-        let (a, b) = (points.point(i), points.point(j));
-        let mut h = [0.0; 4];
-        for ((hk, x), y) in h.iter_mut().zip(a).zip(b) {
-            *hk = x - y;
-        }
-        f.autocov(&h[..d]).expect("checked above")
+        f.autocov_between(points.point(i), points.point(j))
+            .expect("checked above")
     };
     let support = grid_support(f, n);
     let off_diagonal = match support {
