@@ -24,16 +24,20 @@ pub fn clip(poly: &[[f64; 2]], n: [f64; 2], level: f64) -> Vec<[f64; 2]> {
 
 /// Area of a simple polygon (counter-clockwise positive); 0 for fewer
 /// than three vertices (an empty clip: std's empty float sum is −0, which
-/// printed as `I = -0`).
+/// printed as `I = -0`). The vertices are taken relative to the first, so
+/// a small polygon far from the origin keeps its digits (a triangle of
+/// area 1.1e-8 at the corner (1, 1) lost seven of them to cross products
+/// of coordinates near 1).
 pub fn shoelace(poly: &[[f64; 2]]) -> f64 {
     let n = poly.len();
     if n < 3 {
         return 0.0;
     }
-    0.5 * (0..n)
+    let o = poly[0];
+    0.5 * (1..n - 1)
         .map(|i| {
-            let (a, b) = (poly[i], poly[(i + 1) % n]);
-            a[0] * b[1] - a[1] * b[0]
+            let (a, b) = (poly[i], poly[i + 1]);
+            (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
         })
         .sum::<f64>()
 }

@@ -292,3 +292,39 @@ fn integrand_constructors_refuse_what_their_closed_forms_cannot_hold() {
     assert!(Layers::new(DefocusShape::Disk, 0.3, 0.5, -0.2, 7.0).is_err());
     assert!(Layers::new(DefocusShape::Disk, 0.3, 0.5, -0.2, 0.5).is_ok());
 }
+
+/// A half-plane covering all but a sliver of the square (area 1 − 1.14e-8)
+/// and its complement: the shift variance of four points, against the
+/// exact rational value for the integrand as represented in doubles (its
+/// f64 normal and level; the clipped polygon and every periodic overlap
+/// P ∩ (P + h + m) in Python's fractions, outside the project). Both read
+/// 2.85055532833e-9 before, 2.9e-9 relative off (the sliver's area was 1
+/// minus the rest of its rectangle), and the large side 1.4e-8 off
+/// (overlaps near 1 minus I² near 1).
+#[test]
+fn a_sliver_and_its_complement_keep_their_variance_digits() {
+    let coords = vec![0.1, 0.2, 0.6, 0.3, 0.35, 0.85, 0.9, 0.7];
+    let set = varspec::points::PointSet::new(2, coords).unwrap();
+    for (spec, exact) in [
+        ("halfplane:angle=135,offset=-0.707", 2.8505553201182595e-9),
+        ("halfplane:angle=45,offset=0.707", 2.850555320124187e-9),
+        ("halfplane:angle=17,offset=0.07", 0.019292486633437588),
+    ] {
+        let (v, _) = varspec::variance::spatial_variance(&set, &*parse(spec)).unwrap();
+        // The level's own rounding (about 2e-16 of a distance of 1.1e-4
+        // from the corner) moves the exact value by about 2e-12.
+        assert!(
+            (v - exact).abs() <= 1e-11 * exact,
+            "{spec}: {v:e} against {exact:e} ({:.1e} relative)",
+            (v - exact).abs() / exact
+        );
+    }
+    // The sliver's integral, exact for its f64 normal and level.
+    let sliver = parse("halfplane:angle=45,offset=0.707");
+    let exact = 1.1402221800539396e-8;
+    assert!(
+        (sliver.integral() - exact).abs() <= 1e-11 * exact,
+        "{:e}",
+        sliver.integral()
+    );
+}

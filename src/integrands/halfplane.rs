@@ -27,6 +27,11 @@ pub struct HalfPlane {
     /// (midpoint, edge vector) of each non-degenerate edge, counter-clockwise.
     edges: Vec<([f64; 2], [f64; 2])>,
     area: f64,
+    /// The smaller of P and its complement, (normal, level, area): c_f is
+    /// the same for both (c_(1−f) = c_f), and overlaps of the smaller side
+    /// do not cancel against I² (a region of area 1 − 1.1e-8 lost seven
+    /// digits of its variance in overlap − I² with both near 1).
+    smaller: ([f64; 2], f64, f64),
 }
 
 impl HalfPlane {
@@ -57,6 +62,13 @@ impl HalfPlane {
         let square = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
         let polygon = clip(&square, n, level);
         let area = shoelace(&polygon);
+        let complement = ([-c, -s], -level);
+        let smaller = if area <= 0.5 {
+            (n, level, area)
+        } else {
+            let area = shoelace(&clip(&square, complement.0, complement.1));
+            (complement.0, complement.1, area)
+        };
         let edges = (0..polygon.len())
             .map(|i| (polygon[i], polygon[(i + 1) % polygon.len()]))
             .map(|(a, b)| {
@@ -74,22 +86,26 @@ impl HalfPlane {
             level,
             edges,
             area,
+            smaller,
         })
     }
 }
 
 /// Area of the rectangle [x0, x0+w] × [y0, y0+h] where n·x ≥ level, in
-/// closed form: n·x over the rectangle is the sum of two uniform variables
-/// of widths p = |n_x|·w and q = |n_y|·h, whose distribution function is
+/// closed form: highest − n·x over the rectangle (highest its largest
+/// value) is the sum of two uniform variables of widths p = |n_x|·w and
+/// q = |n_y|·h, whose distribution function at t = highest − level is
 /// t²/(2pq), (t − p/2)/q, 1 − (p+q−t)²/(2pq) on the three pieces (p ≤ q).
+/// Measured from the highest corner, a sliver above the level is computed
+/// directly (as 1 − the rest it lost seven digits at an area of 1e-8).
 /// Only the middle piece divides by the larger width, so the formula stays
 /// exact as p → 0 (edges at 1e-9 degrees).
 fn rect_above(w: f64, h: f64, corner: [f64; 2], n: [f64; 2], level: f64) -> f64 {
     let (pw, qh) = ((n[0] * w).abs(), (n[1] * h).abs());
     let (p, q) = if pw <= qh { (pw, qh) } else { (qh, pw) };
-    let lowest = n[0] * corner[0] + n[1] * corner[1] + (n[0] * w).min(0.0) + (n[1] * h).min(0.0);
-    let t = level - lowest;
-    let below = if t <= 0.0 {
+    let highest = n[0] * corner[0] + n[1] * corner[1] + (n[0] * w).max(0.0) + (n[1] * h).max(0.0);
+    let t = highest - level;
+    let above = if t <= 0.0 {
         0.0
     } else if t >= p + q {
         1.0
@@ -101,7 +117,7 @@ fn rect_above(w: f64, h: f64, corner: [f64; 2], n: [f64; 2], level: f64) -> f64 
         let r = p + q - t;
         1.0 - r * (r / p) / (2.0 * q)
     };
-    w * h * (1.0 - below)
+    w * h * above
 }
 
 impl Integrand for HalfPlane {
@@ -114,7 +130,8 @@ impl Integrand for HalfPlane {
     }
 
     fn variance(&self) -> f64 {
-        self.area * (1.0 - self.area)
+        let a = self.smaller.2;
+        a * (1.0 - a)
     }
 
     fn eval(&self, x: &[f64]) -> f64 {
@@ -145,6 +162,7 @@ impl Integrand for HalfPlane {
         // P ∩ (P + t) is the rectangle [0,1]² ∩ ([0,1]² + t) cut by
         // n·x ≥ level + max(0, n·t).
         let h = [h[0] - h[0].floor(), h[1] - h[1].floor()];
+        let (n, level, area) = self.smaller;
         let mut overlap = 0.0;
         for mx in [-1.0, 0.0] {
             for my in [-1.0, 0.0] {
@@ -152,12 +170,12 @@ impl Integrand for HalfPlane {
                 let (x0, x1) = (t[0].max(0.0), (1.0 + t[0]).min(1.0));
                 let (y0, y1) = (t[1].max(0.0), (1.0 + t[1]).min(1.0));
                 if x1 > x0 && y1 > y0 {
-                    let level = self.level + (self.n[0] * t[0] + self.n[1] * t[1]).max(0.0);
-                    overlap += rect_above(x1 - x0, y1 - y0, [x0, y0], self.n, level);
+                    let level = level + (n[0] * t[0] + n[1] * t[1]).max(0.0);
+                    overlap += rect_above(x1 - x0, y1 - y0, [x0, y0], n, level);
                 }
             }
         }
-        Some(overlap - self.area * self.area)
+        Some(overlap - area * area)
     }
 
     fn class(&self) -> IntegrandClass {
