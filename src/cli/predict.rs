@@ -15,7 +15,7 @@ use varspec::integrands::{self, Integrand};
 use varspec::scene::pixel::PixelIntegrand;
 use varspec::source::Source;
 use varspec::variance::{
-    ClosedForm, DEFAULT_SHIFT_SEED, TARGET_RELATIVE_STDERR, VarianceError, auto_set_cap,
+    ClosedForm, DEFAULT_SHIFT_SEED, SetCount, TARGET_RELATIVE_STDERR, VarianceError, auto_set_cap,
     empirical_shifting, expected_min_half, fourier_parts, radial_from, sets_for_relative_stderr,
     spatial,
 };
@@ -128,6 +128,12 @@ const DEFAULT_TOLERANCE: f64 = 1e-10;
 /// A standard error over `sets` realizations: unknown (JSON null) from one.
 fn known_stderr(stderr: f64, sets: usize) -> Option<f64> {
     (sets >= 2).then_some(stderr)
+}
+
+/// True when two or more sets gave one nonzero value (a spread within
+/// rounding of it): from random sets, no evidence of their variability.
+fn no_spread(variance: f64, stderr: f64, rounding_bound: f64, sets: usize) -> bool {
+    sets >= 2 && variance > rounding_bound && stderr <= 1e-12 * variance
 }
 
 pub fn run(a: Args) -> anyhow::Result<()> {
@@ -342,18 +348,32 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // their standard error exceeds 5% of the variance the forms run again
     // on as many sets as reach it (variance::sets).
     let mut drawn = Vec::new();
+    // A sampler's sets vary from draw to draw unless they are shifts of one
+    // lattice (regular, uniform jitter, lattices), whose spatial values agree.
+    let random_sets =
+        matches!(&source, Source::Sampler { sampler, .. } if sampler.lattice().is_none());
     if wants(MethodArg::Fourier) || wants(MethodArg::Spatial) || wants(MethodArg::Radial) {
         drawn = source.realizations()?;
-        let relative = set_forms(&a, f.as_ref(), &drawn, &wants, &mut out)?;
+        let relative = set_forms(&a, f.as_ref(), &drawn, random_sets, &wants, &mut out)?;
         if let (false, Source::Sampler { sets, .. }) = (a.source.sets_were_given(), &mut source) {
             let pilot = *sets;
             let cap = auto_set_cap(n, f.dim(), wants(MethodArg::Spatial));
             let relative = relative.unwrap_or(0.0);
-            let count = sets_for_relative_stderr(pilot, relative, TARGET_RELATIVE_STDERR, cap);
+            // Random sets that all gave one value show no spread to scale
+            // from: draw as many as the default work allows.
+            let unseen = relative == f64::INFINITY;
+            let count = if unseen {
+                SetCount {
+                    sets: cap.max(pilot),
+                    wanted: cap.max(pilot),
+                }
+            } else {
+                sets_for_relative_stderr(pilot, relative, TARGET_RELATIVE_STDERR, cap)
+            };
             if count.sets > pilot {
                 *sets = count.sets;
                 drawn = source.realizations()?;
-                set_forms(&a, f.as_ref(), &drawn, &wants, &mut out)?;
+                set_forms(&a, f.as_ref(), &drawn, random_sets, &wants, &mut out)?;
             }
             out.insert(
                 "auto_sets".into(),
@@ -363,7 +383,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     "wanted": count.wanted, "capped": count.capped(),
                 }),
             );
-            if count.sets > pilot || count.capped() {
+            if unseen && count.sets > pilot {
+                eprintln!(
+                    "note: {pilot} random sets gave one spatial value (no spread: what varies \
+                     between sets, such as pairs within a small integrand's reach, did not occur \
+                     in them); drew {} sets, the most the default work allows (R·N² ≤ 2^30 point \
+                     pairs, 256 MiB of sets); --sets fixes the count",
+                    count.sets
+                );
+            } else if count.sets > pilot || count.capped() {
                 let drew = if count.capped() {
                     format!(
                         "drew {} sets, the most the default work allows (R·N² ≤ 2^30 point \
@@ -500,6 +528,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 },
                 _ => match v[extra].as_f64() {
                     Some(x) => format!("{extra} {x:.2e}"),
+                    None if v["stderr_unknown"].is_string() => format!(
+                        "{extra} unknown ({})",
+                        v["stderr_unknown"].as_str().unwrap_or_default()
+                    ),
                     None => format!(
                         "{extra} unknown (one set: draw 2 or more with --sets, or give a file of 2 or more sets)"
                     ),
@@ -576,6 +608,7 @@ fn set_forms(
     a: &Args,
     f: &dyn Integrand,
     drawn: &[PointSet],
+    random_sets: bool,
     wants: &dyn Fn(MethodArg) -> bool,
     out: &mut serde_json::Map<String, Value>,
 ) -> anyhow::Result<Option<f64>> {
@@ -638,6 +671,25 @@ fn set_forms(
         });
         bar.finish_and_clear();
         let value = match spatial {
+            Ok(e) if random_sets && no_spread(e.variance, e.stderr, e.rounding_bound, e.sets) => {
+                // Every random set gave the same value: what varies between
+                // sets (pairs within the integrand's reach) was not seen,
+                // so the spread says nothing; the automatic count draws
+                // as many sets as it may.
+                relative = Some(f64::INFINITY);
+                json!({
+                "variance": e.variance, "stderr": Value::Null,
+                "stderr_unknown": format!(
+                    "all {} sets gave the same value: what varies between random sets (for \
+                     an integrand of small support, pairs closer than its reach) did not occur \
+                     in them, so their spread of 0 is no standard error; draw more with \
+                     --sets, or use --method expected where the sampler has a closed form",
+                    e.sets
+                ),
+                "rounding_bound": e.rounding_bound,
+                "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
+                })
+            }
             Ok(e) => {
                 note(e.variance, e.stderr, e.rounding_bound, e.sets);
                 json!({
