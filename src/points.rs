@@ -31,7 +31,7 @@ pub enum PointSetError {
         value: f64,
     },
     /// Outside [0, 1).
-    #[error("point {point}, coordinate {coord} is {value}, outside [0, 1)")]
+    #[error("point {point}, coordinate {coord} is {}, outside [0, 1)", crate::spec_params::SpecValue(*value))]
     OutOfRange {
         /// Point index.
         point: usize,

@@ -252,6 +252,9 @@ fn bad_specs_are_clear_errors() {
         ("box:w=0.9,h=0.9,angle=45", "periodic images"),
         ("gaussian:sx=0", "(0, 0.5]"),
         ("cos:kx=1.5", "integer"),
+        // The bound is named (it read "an integer" for a 13-digit integer).
+        ("cos:kx=2000000000000", "an integer in [-2^40, 2^40]"),
+        ("cos:ky=1e3", "without a decimal point or exponent"),
         ("defocus:shape=star", "box, disk or gaussian"),
         ("halfplane:offset=inf", "[-1, 1]"),
         ("layers:c1=0.3,c2=0.26", "at least 0.05 from c1"),

@@ -137,6 +137,20 @@ fn every_malformed_input_names_its_line() {
             |p| matches!(p, LineProblem::OutOfRange { field: 1, .. }),
             "-0.5",
         ),
+        // Quoted as written (Display printed 300 digits of -1e-300).
+        (
+            "x0,x1\n-1e-300,0.1\n",
+            2,
+            |p| matches!(p, LineProblem::OutOfRange { field: 1, .. }),
+            "field 1 is `-1e-300`, outside [0, 1)",
+        ),
+        // A decimal below 1 that reads as the double 1 says so.
+        (
+            "x0,x1\n0.1,0.99999999999999995\n",
+            2,
+            |p| matches!(p, LineProblem::OutOfRange { field: 2, .. }),
+            "`0.99999999999999995`, which rounds to the double 1,",
+        ),
         (
             "x0,x1\n0.1,0.2\n0.3\n",
             3,

@@ -182,7 +182,13 @@ impl Params {
             .parse::<i64>()
             .ok()
             .filter(|v| v.unsigned_abs() <= 1 << 40)
-            .ok_or_else(|| self.bad(key, "an integer (the integrand must be periodic)"))
+            .ok_or_else(|| {
+                self.bad(
+                    key,
+                    "an integer in [-2^40, 2^40] (whole periods keep the integrand periodic; \
+                     the bound keeps its phase exact), written without a decimal point or exponent",
+                )
+            })
     }
 
     fn shape(&self) -> Result<DefocusShape, IntegrandError> {

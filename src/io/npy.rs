@@ -130,8 +130,16 @@ pub fn read_point_sets_npy(mut reader: impl Read) -> Result<Vec<PointSet>, Strin
                 for j in 0..d {
                     let v = values[at(s, i, j)];
                     if !(v.is_finite() && (0.0..1.0).contains(&v)) {
+                        // Short: -1e-300, not 300 digits.
+                        let why = if v == 1.0 {
+                            " (a value stored below 1 may have rounded to 1: the largest float32 \
+                             below 1 is 0.99999994, the largest float64 0.9999999999999999)"
+                        } else {
+                            ""
+                        };
                         return Err(format!(
-                            "value [{s}, {i}, {j}] is {v}, outside [0, 1) or not finite"
+                            "value [{s}, {i}, {j}] is {}, outside [0, 1) or not finite{why}",
+                            crate::spec_params::SpecValue(v)
                         ));
                     }
                     coords.push(v);

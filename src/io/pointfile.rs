@@ -112,6 +112,8 @@ pub enum LineProblem {
         field: usize,
         /// The value.
         value: f64,
+        /// Its text (quoted as written: `-1e-300` is not 300 digits).
+        text: String,
     },
     /// A row with the wrong number of fields.
     Ragged {
@@ -154,12 +156,21 @@ impl fmt::Display for LineProblem {
             LineProblem::NotFinite { field, text } => {
                 write!(f, "field {field} is `{text}`, not a finite number")
             }
-            LineProblem::OutOfRange { field, value } if *value == 1.0 => write!(
-                f,
-                "field {field} is 1, outside [0, 1) (on the torus 1 is the same point as 0: write 0)"
-            ),
-            LineProblem::OutOfRange { field, value } => {
-                write!(f, "field {field} is {value}, outside [0, 1)")
+            LineProblem::OutOfRange { field, value, text } if *value == 1.0 => {
+                // 0.99999999999999995 reads as the double 1.
+                let rounds = if text.trim_start_matches('+').starts_with("0.") {
+                    format!("`{text}`, which rounds to the double 1,")
+                } else {
+                    "1,".to_string()
+                };
+                write!(
+                    f,
+                    "field {field} is {rounds} outside [0, 1) (on the torus 1 is the same point \
+                     as 0: write 0; the largest double below 1 is 0.9999999999999999)"
+                )
+            }
+            LineProblem::OutOfRange { field, text, .. } => {
+                write!(f, "field {field} is `{text}`, outside [0, 1)")
             }
             LineProblem::Ragged { expected, found } => {
                 let fields = if *found == 1 { "field" } else { "fields" };
@@ -613,7 +624,11 @@ fn coordinate(text: &str, field: usize) -> Result<f64, LineProblem> {
         });
     }
     if !(0.0..1.0).contains(&v) {
-        return Err(LineProblem::OutOfRange { field, value: v });
+        return Err(LineProblem::OutOfRange {
+            field,
+            value: v,
+            text: quote(text),
+        });
     }
     Ok(v + 0.0)
 }
