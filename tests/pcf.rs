@@ -154,3 +154,27 @@ fn the_default_range_fits_the_torus_and_a_given_one_is_kept() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Where even a range down to the bandwidth would reach half the torus
+/// (N = 4 in 2D: half the torus is 0.931 r_max, and 6 default kernel
+/// widths alone take 0.9), the default range and bandwidth shrink by one
+/// factor, 0.99·0.931/3.4 (the note was documented, but the command
+/// refused instead); a bandwidth given is kept, and then refused.
+#[test]
+fn few_points_shrink_the_default_bandwidth_with_the_range() {
+    let dir = crate::common::temp_dir("pcf-few");
+    let points = dir.join("p4.csv");
+    std::fs::write(&points, "x0,x1\n0.1,0.2\n0.6,0.3\n0.35,0.85\n0.9,0.7\n").unwrap();
+    let out = crate::common::varspec_ok(&["pcf", points.to_str().unwrap()]);
+    let note = String::from_utf8_lossy(&out.stderr);
+    // r_max = √(2/(√3·4)) = 0.537285, half the torus 0.930605 r_max.
+    assert!(
+        note.contains("--range 0.677 r_max (not 2.5) and --bandwidth 0.0406 (not 0.15)"),
+        "{note}"
+    );
+    crate::common::assert_fails(
+        &["pcf", points.to_str().unwrap(), "--bandwidth", "0.15"],
+        "use more points (or a smaller --bandwidth)",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

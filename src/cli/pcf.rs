@@ -28,9 +28,11 @@ pub struct Args {
     /// Radii evaluated in (0, range].
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 100)]
     bins: usize,
-    /// Gaussian kernel standard deviation σ, in units of r_max.
-    #[arg(long, default_value_t = 0.15)]
-    bandwidth: f64,
+    /// Gaussian kernel standard deviation σ, in units of r_max [default:
+    /// 0.15, or less, with the range, where the default range would reach
+    /// half the torus].
+    #[arg(long)]
+    bandwidth: Option<f64>,
     /// CSV output: r,r_rel,g (r_rel = r / r_max). Default: standard output.
     #[arg(long)]
     csv: Option<PathBuf>,
@@ -42,6 +44,9 @@ pub struct Args {
 /// `--range` when not given, where it fits the torus.
 const DEFAULT_RANGE: f64 = 2.5;
 
+/// `--bandwidth` when not given, where the default range fits the torus.
+const DEFAULT_BANDWIDTH: f64 = 0.15;
+
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs_beside([a.csv.as_deref(), a.png.as_deref()], [a.source.file()])?;
     let given = a.range;
@@ -50,18 +55,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     {
         bail!(
             "--range {range:?}: the largest radius, in units of the packing distance r_max, must \
-             be a number of at least 0.001, the smallest --bandwidth (default 2.5)"
+             be a finite number of at least 0.001, the smallest --bandwidth (default 2.5)"
         );
     }
     let mut range = given.unwrap_or(DEFAULT_RANGE);
     if a.bins == 0 {
         bail!("--bins 0: the number of radii must be at least 1 (default 100)");
     }
-    if !(a.bandwidth.is_finite() && a.bandwidth >= 1e-3 && a.bandwidth <= range) {
+    let mut bandwidth = a.bandwidth.unwrap_or(DEFAULT_BANDWIDTH);
+    if !(bandwidth.is_finite() && bandwidth >= 1e-3 && bandwidth <= range) {
         bail!(
             "--bandwidth {:?}: the kernel's σ, in units of the packing distance r_max, must be in \
              [0.001, --range = {range:?}] (default 0.15; below 0.001 no pair falls within a kernel width)",
-            a.bandwidth,
+            bandwidth,
         );
     }
     let source = a.source.resolve(None)?;
@@ -82,42 +88,61 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // distances alias): say so in the units the options are given in.
     // The default shrinks to fit (to 99% of the largest range that does),
     // saying so; a range given is kept or refused.
-    let largest = 0.5 / unit - KERNEL_REACH * a.bandwidth;
-    if given.is_none() && range >= largest && 0.99 * largest >= a.bandwidth {
-        range = 0.99 * largest;
-        eprintln!(
-            "note: --range {range:.3} r_max (not {DEFAULT_RANGE}): with N = {n} in {d}D half the \
-             torus is {:.3} r_max, and the range plus 6 kernel widths ({:.3} r_max) must stay \
-             below it, where the pair correlation would alias",
-            0.5 / unit,
-            6.0 * a.bandwidth
-        );
+    let half = 0.5 / unit;
+    let mut largest = half - KERNEL_REACH * bandwidth;
+    if given.is_none() && range >= largest {
+        // The range alone while it stays above the bandwidth; below that
+        // (N ≤ 4 in 2D, ≤ 32 in 4D), with the bandwidth at its default
+        // too, both shrink by one factor (the default's σ = range/16.7).
+        let (shrunk_range, shrunk_bandwidth) =
+            if 0.99 * largest >= bandwidth || a.bandwidth.is_some() {
+                (0.99 * largest, bandwidth)
+            } else {
+                let scale = 0.99 * half / (DEFAULT_RANGE + KERNEL_REACH * DEFAULT_BANDWIDTH);
+                (DEFAULT_RANGE * scale, DEFAULT_BANDWIDTH * scale)
+            };
+        if shrunk_range >= shrunk_bandwidth && shrunk_bandwidth >= 1e-3 {
+            let narrower = shrunk_bandwidth < bandwidth;
+            (range, bandwidth) = (shrunk_range, shrunk_bandwidth);
+            largest = half - KERNEL_REACH * bandwidth;
+            eprintln!(
+                "note: --range {range:.3} r_max (not {DEFAULT_RANGE}){}: with N = {n} in {d}D \
+                 half the torus is {half:.3} r_max, and the range plus 6 kernel widths \
+                 ({:.3} r_max) must stay below it, where the pair correlation would alias",
+                if narrower {
+                    format!(" and --bandwidth {bandwidth:.4} (not {DEFAULT_BANDWIDTH})")
+                } else {
+                    String::new()
+                },
+                KERNEL_REACH * bandwidth
+            );
+        }
     }
-    let reach = range + 6.0 * a.bandwidth;
+    let reach = range + KERNEL_REACH * bandwidth;
     if reach * unit >= 0.5 {
         bail!(
             "--range {:?} + 6 x --bandwidth {:?} = {reach:.3} packing distances reaches half the torus \
              (r_max = {unit:.4} for N = {n}: the pair correlation aliases beyond {:.3} r_max); {}",
             range,
-            a.bandwidth,
+            bandwidth,
             0.5 / unit,
-            if largest > a.bandwidth {
+            if largest > bandwidth {
                 format!("lower --range to below {largest:.3}, or use more points")
             } else {
                 "use more points (or a smaller --bandwidth)".to_string()
             }
         );
     }
-    let work = kernel_evaluations(&sets, range * unit, a.bins, a.bandwidth * unit);
+    let work = kernel_evaluations(&sets, range * unit, a.bins, bandwidth * unit);
     if work > LONG_WORK {
         eprintln!(
             "note: about {work:.1e} kernel evaluations (pairs within reach x the bins within \
              {KERNEL_REACH} bandwidths of each): this may take a long time; fewer --bins (the \
              kernel spans {:.0} of them) or a smaller --bandwidth make it faster",
-            (2.0 * KERNEL_REACH * a.bandwidth / (range / a.bins as f64)).min(a.bins as f64)
+            (2.0 * KERNEL_REACH * bandwidth / (range / a.bins as f64)).min(a.bins as f64)
         );
     }
-    let pcf = pair_correlation(&sets, range * unit, a.bins, a.bandwidth * unit)?;
+    let pcf = pair_correlation(&sets, range * unit, a.bins, bandwidth * unit)?;
     #[derive(serde::Serialize)]
     struct Row {
         r: f64,
