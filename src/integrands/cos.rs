@@ -31,10 +31,9 @@ impl Cosine {
         Ok(Cosine { k0 })
     }
 
-    /// cos(2π k₀·h) with exact phase reduction (k₀ may be 4000 or more).
-    fn cos_phase(&self, h: &[f64]) -> f64 {
-        let t = reduced_phase(self.k0[0], h[0]) + reduced_phase(self.k0[1], h[1]);
-        (std::f64::consts::TAU * (t - t.round())).cos()
+    /// k₀·x mod 1 with exact phase reduction (k₀ may be 4000 or more).
+    fn phase(&self, x: &[f64]) -> f64 {
+        reduced_phase(self.k0[0], x[0]) + reduced_phase(self.k0[1], x[1])
     }
 
     fn constant(&self) -> bool {
@@ -56,7 +55,7 @@ impl Integrand for Cosine {
     }
 
     fn eval(&self, x: &[f64]) -> f64 {
-        1.0 + self.cos_phase(x)
+        1.0 + cos_turns(self.phase(x))
     }
 
     fn fourier(&self, k: &[i64]) -> Complex64 {
@@ -69,22 +68,16 @@ impl Integrand for Cosine {
     }
 
     fn autocov(&self, h: &[f64]) -> Option<f64> {
-        Some(if self.constant() {
-            0.0
-        } else {
-            0.5 * self.cos_phase(h)
-        })
+        self.autocov_between(h, &[0.0, 0.0])
     }
 
     fn autocov_between(&self, x: &[f64], y: &[f64]) -> Option<f64> {
         // Each point's phase k₀·x mod 1 is exact to rounding; their
         // difference is the phase of x − y without the rounding of x − y.
-        let phase = |p: &[f64]| reduced_phase(self.k0[0], p[0]) + reduced_phase(self.k0[1], p[1]);
-        let t = phase(x) - phase(y);
         Some(if self.constant() {
             0.0
         } else {
-            0.5 * (std::f64::consts::TAU * (t - t.round())).cos()
+            0.5 * cos_turns(self.phase(x) - self.phase(y))
         })
     }
 
@@ -98,4 +91,9 @@ impl Integrand for Cosine {
     fn spec(&self) -> String {
         format!("cos:kx={},ky={}", self.k0[0], self.k0[1])
     }
+}
+
+/// cos(2π t) for a phase t in turns, reduced to [−½, ½] first.
+fn cos_turns(t: f64) -> f64 {
+    (std::f64::consts::TAU * (t - t.round())).cos()
 }
