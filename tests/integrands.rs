@@ -296,6 +296,31 @@ fn integrand_constructors_refuse_what_their_closed_forms_cannot_hold() {
     assert!(Layers::new(DefocusShape::Disk, 0.3, 0.5, -0.2, 0.5).is_ok());
 }
 
+/// Axis-aligned boxes of area near 1 (a band of height 1 − 1e-8, a square
+/// of side 1 − 1e-8) and two ordinary ones, one at 90°: the shift variance
+/// of four points against exact rationals for the boxes as represented in
+/// doubles (every periodic overlap in Python's fractions, outside the
+/// project). The near-1 boxes read 4.4e-9 and 3.6e-8 relative off before
+/// (overlaps near 1 less A² near 1).
+#[test]
+fn boxes_of_area_near_one_keep_their_variance_digits() {
+    let coords = vec![0.1, 0.2, 0.6, 0.3, 0.35, 0.85, 0.9, 0.7];
+    let set = varspec::points::PointSet::new(2, coords).unwrap();
+    for (spec, exact) in [
+        ("box:w=1,h=0.99999999", 2.4999999125618973e-9),
+        ("box:w=0.99999999,h=0.99999999", 4.9999997501237975e-9),
+        ("box:w=1,h=0.3,angle=90", 0.010000000000000005),
+        ("box:w=0.3,h=0.2", 0.0114),
+    ] {
+        let (v, _) = varspec::variance::spatial_variance(&set, &*parse(spec)).unwrap();
+        assert!(
+            (v - exact).abs() <= 1e-13 * exact,
+            "{spec}: {v:e} against {exact:e} ({:.1e} relative)",
+            (v - exact).abs() / exact
+        );
+    }
+}
+
 /// A half-plane covering all but a sliver of the square (area 1 − 1.14e-8)
 /// and its complement: the shift variance of four points, against the
 /// exact rational value for the integrand as represented in doubles (its
