@@ -349,6 +349,42 @@ pub fn split_spec<'a>(
     Ok((name, all))
 }
 
+/// The parameters a sampler is built with, one per key: [`split_spec`]'s
+/// with each key's last value (`--param` overrides the shorthand), in the
+/// order the keys first appear.
+///
+/// # Errors
+/// As [`split_spec`].
+pub fn resolved_params<'a>(
+    name: &'a str,
+    params: &[(String, String)],
+) -> Result<(&'a str, Params), SamplerError> {
+    let (base, given) = split_spec(name, params)?;
+    let mut resolved: Params = Vec::with_capacity(given.len());
+    for (key, value) in given {
+        match resolved.iter_mut().find(|(k, _)| *k == key) {
+            Some(slot) => slot.1 = value,
+            None => resolved.push((key, value)),
+        }
+    }
+    Ok((base, resolved))
+}
+
+/// The sampler as it runs, for titles and metadata: `spec` as written when
+/// no `--param` is given, else its name with the resolved parameters
+/// (`padded:xy=cmj` with `--param xy=jitter` is `padded:xy=jitter`).
+///
+/// # Errors
+/// As [`split_spec`].
+pub fn label(spec: &str, params: &[(String, String)]) -> Result<String, SamplerError> {
+    if params.is_empty() {
+        return Ok(spec.trim().to_string());
+    }
+    let (base, resolved) = resolved_params(spec, params)?;
+    let pairs: Vec<String> = resolved.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    Ok(format!("{}:{}", base.trim(), pairs.join(",")))
+}
+
 /// Builds sampler `name` for N = `n` points in `dim` dimensions (the
 /// sampler's default when `None`) with `key=value` parameters.
 ///

@@ -369,6 +369,48 @@ fn bad_requests_fail_with_a_specific_message() {
     }
 }
 
+/// The label of a drawn source is the sampler as it runs: `--param` wins
+/// over the shorthand, in the sets and in the name (the name kept the
+/// shorthand's cmj while jitter ran: trial).
+#[test]
+fn a_param_override_names_the_sampler_as_it_runs() {
+    let predict = |extra: &[&str]| {
+        let mut args = vec![
+            "predict",
+            "-n",
+            "16",
+            "--dims",
+            "0,1",
+            "--integrand",
+            "disk:r=0.3",
+        ];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--method", "spatial", "--json"]);
+        let out = varspec(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (
+            v["source"].clone(),
+            v["spatial"]["variance"].as_f64().unwrap(),
+        )
+    };
+    let (name, overridden) = predict(&[
+        "--sampler",
+        "padded:xy=cmj,uv=jitter",
+        "--param",
+        "xy=jitter",
+    ]);
+    let (_, direct) = predict(&["--sampler", "padded:xy=jitter,uv=jitter"]);
+    let (_, cmj) = predict(&["--sampler", "padded:xy=cmj,uv=jitter"]);
+    assert_eq!(name, "padded:xy=jitter,uv=jitter N=16");
+    assert_eq!(overridden, direct, "--param xy=jitter did not draw jitter");
+    assert_ne!(overridden, cmj);
+}
+
 #[test]
 fn a_file_source_refuses_the_sampler_options_it_would_ignore() {
     let dir = temp_dir("filesrc");

@@ -621,3 +621,41 @@ fn predict_on_a_pixel_is_identical_on_one_and_two_threads() {
     assert!(one["integral_stderr"].as_f64().unwrap() > 0.0, "{one}");
     assert_eq!(one, run("2"));
 }
+
+/// `--param` wins over the shorthand, and the outputs name the sampler that
+/// ran: the image is padded:xy=jitter's, so the summary and the titles say
+/// so (they said padded:xy=cmj: trial).
+#[test]
+fn a_param_override_renders_and_is_named_as_it_runs() {
+    let dir = temp_dir("render-param");
+    let render = |sampler: &[&str], tag: &str| {
+        let npy = dir.join(format!("{tag}.npy"));
+        let summary = dir.join(format!("{tag}.json"));
+        let mut args = vec!["render", "dof", "--spp", "4"];
+        args.extend_from_slice(sampler);
+        let (npy_s, summary_s) = (npy.to_str().unwrap(), summary.to_str().unwrap());
+        args.extend_from_slice(&["--npy", npy_s, "--summary", summary_s]);
+        let out = varspec_with(&args, Some("2"));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        (
+            std::fs::read(&npy).unwrap(),
+            common::read_json(&summary)["sampler"].clone(),
+        )
+    };
+    let (overridden, named) = render(
+        &["--sampler", "padded:xy=cmj", "--param", "xy=jitter"],
+        "override",
+    );
+    let (direct, _) = render(&["--sampler", "padded:xy=jitter"], "direct");
+    let (cmj, _) = render(&["--sampler", "padded:xy=cmj"], "cmj");
+    assert!(
+        overridden == direct,
+        "--param xy=jitter did not draw jitter"
+    );
+    assert!(overridden != cmj, "the override drew the shorthand's cmj");
+    assert_eq!(named, "padded:xy=jitter");
+}

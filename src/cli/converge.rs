@@ -168,7 +168,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         );
     }
     // The label of the sets: the sampler, or "point files".
-    let label = a.sampler.clone().unwrap_or_else(|| "point files".into());
+    let label = match &a.sampler {
+        Some(spec) => registry::label(spec, &a.draw.params)?,
+        None => "point files".into(),
+    };
     let method = a.method.unwrap_or(if dim == 2 {
         MethodArg::Spatial
     } else {

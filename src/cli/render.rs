@@ -178,6 +178,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         ),
         e => e.into(),
     })?;
+    // From here on titles and the summary name the sampler as it runs
+    // (--param wins over the shorthand).
+    let a = Args {
+        sampler: registry::label(&a.sampler, &a.params)?,
+        ..a
+    };
     let [w, h] = scene.camera().resolution();
     // Read and check the reference before the renders, not after them.
     let reference = match &a.reference {

@@ -88,6 +88,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     );
     args::check_outputs([a.output.as_deref()])?;
     let sampler = registry::build(&name, n, a.dim, &a.params)?;
+    let name = registry::label(&name, &a.params)?;
     args::note_caveat(sampler.as_ref());
     let format = Format::resolve(a.format, a.output.as_deref());
     note_large_output(format, sampler.points_per_set(), sampler.dim(), a.sets);

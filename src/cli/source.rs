@@ -149,7 +149,7 @@ impl SourceArgs {
                     seed: self.draw.seed(),
                     sets: self.draw.sets(),
                     dims: dims.clone(),
-                    name: format!("{name} N={n}"),
+                    name: format!("{} N={n}", registry::label(name, &self.draw.params)?),
                 }
             }
             (None, None) => {

@@ -130,13 +130,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             super::args::note_caveat(s.as_ref());
             // The metadata records the parameters the sampler was built
             // with, in one place: the shorthand's and --param's (which win).
-            let (base, given) = registry::split_spec(name, &a.draw.params)?;
-            run_params = given
-                .iter()
-                .enumerate()
-                .filter(|(i, (k, _))| !given[i + 1..].iter().any(|(later, _)| later == k))
-                .map(|(_, kv)| kv.clone())
-                .collect();
+            let (base, resolved) = registry::resolved_params(name, &a.draw.params)?;
+            run_params = resolved;
             run_sampler = Some(base.to_string());
             let bar = progress::bar(a.draw.sets() as u64, "sampling");
             let sets =

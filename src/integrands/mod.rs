@@ -113,6 +113,15 @@ pub enum IntegrandError {
         /// Known names.
         known: String,
     },
+    /// A scene pixel given where a closed-form integrand is needed.
+    #[error(
+        "`scene:` pixels are integrands of predict, spectrum and optimize shear only (their values \
+         come from rendering: no closed form and no family to draw from); here use one of: {known}"
+    )]
+    ScenePixel {
+        /// Known names.
+        known: String,
+    },
     /// A key the integrand does not take.
     #[error("{integrand}: unknown parameter `{key}`{suggestion}; its parameters: {known}")]
     UnknownKey {

@@ -230,6 +230,16 @@ impl Params {
 pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
     let (name, rest) = spec.split_once(':').unwrap_or((spec, ""));
     let name = name.trim();
+    let known = || {
+        INTEGRANDS
+            .iter()
+            .map(|i| i.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if name == "scene" {
+        return Err(IntegrandError::ScenePixel { known: known() });
+    }
     let info =
         INTEGRANDS
             .iter()
@@ -237,11 +247,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
             .ok_or_else(|| IntegrandError::Unknown {
                 name: name.to_string(),
                 suggestion: crate::suggest::did_you_mean(name, INTEGRANDS.iter().map(|i| i.name)),
-                known: INTEGRANDS
-                    .iter()
-                    .map(|i| i.name)
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                known: known(),
             })?;
     let mut pairs = Vec::new();
     let list = crate::spec_params::key_values(rest).map_err(|reason| IntegrandError::Syntax {

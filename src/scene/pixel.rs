@@ -64,9 +64,11 @@ pub enum PixelError {
 }
 
 impl PixelIntegrand {
-    /// True for a spec this type parses (`scene:...`).
+    /// True for a spec this type parses (`scene:...`, whitespace around
+    /// `scene` ignored as in every spec).
     pub fn is_pixel_spec(spec: &str) -> bool {
-        spec.starts_with("scene:")
+        spec.split_once(':')
+            .is_some_and(|(head, _)| head.trim() == "scene")
     }
 
     /// The files a pixel spec reads ([`Scene::files_read`] of its scene;
@@ -103,12 +105,14 @@ impl PixelIntegrand {
             spec: spec.into(),
             message,
         };
-        let rest = spec
-            .strip_prefix("scene:")
-            .ok_or_else(|| fail("no `scene:` prefix".into()))?;
+        let rest = match spec.split_once(':') {
+            Some((head, rest)) if head.trim() == "scene" => rest,
+            _ => return Err(fail("no `scene:` prefix".into())),
+        };
         let (name, params) = rest
             .split_once(',')
             .ok_or_else(|| fail("no pixel given".into()))?;
+        let name = name.trim();
         if name.is_empty() || name.contains('=') {
             return Err(fail(format!(
                 "no scene name (the built-in scenes: {})",
@@ -342,5 +346,30 @@ impl Integrand for PixelIntegrand {
 
     fn spec(&self) -> String {
         format!("scene:{},px={},py={}", self.scene.name(), self.px, self.py)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::PixelIntegrand;
+
+    /// Whitespace around `scene`, the name, keys and values is ignored, as
+    /// in every spec (`scene:dof ,px=3,py=4` looked for a scene `dof `).
+    #[test]
+    fn whitespace_around_the_parts_of_a_pixel_spec_is_ignored() {
+        for spec in [
+            "scene:dof,px=3,py=4",
+            " scene : dof , px = 3 , py = 4 ",
+            "scene:dof ,px=3,py=4",
+        ] {
+            assert!(PixelIntegrand::is_pixel_spec(spec), "{spec}");
+            assert_eq!(
+                PixelIntegrand::parse_spec(spec).unwrap(),
+                ("dof", 3, 4),
+                "{spec}"
+            );
+        }
+        assert!(!PixelIntegrand::is_pixel_spec("scenery:dof,px=3,py=4"));
+        assert!(PixelIntegrand::parse_spec("disk:r=0.3").is_err());
     }
 }

@@ -373,7 +373,9 @@ fn draw(sampler: &dyn Sampler, seed: u64, sets: usize) -> Result<Vec<PointSet>, 
 pub fn run_tour(options: &TourOptions, progress: &dyn Fn(&str)) -> Result<Tour, TourError> {
     let clock = Instant::now();
     options.check()?;
-    std::fs::create_dir_all(&options.folder).map_err(at("creating the report folder"))?;
+    std::fs::create_dir_all(&options.folder)
+        .map_err(|e| format!("{}: {e}", options.folder.display()))
+        .map_err(at("creating the report folder"))?;
     progress("samplers and predictors");
     let predict = predict_section(options)?;
     progress("a design for the square");
