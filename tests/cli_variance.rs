@@ -1277,4 +1277,35 @@ fn random_sets_with_no_spread_have_no_standard_error() {
         Some(0.0),
         "{lattice}"
     );
+    // So do the 4D grid's and uniform jitter's, projected (they were taken
+    // for random sets: stderr null and 1024 sets drawn: review).
+    for sampler in ["regular", "uniform-jitter"] {
+        let grid = json(&[
+            "predict",
+            "--sampler",
+            sampler,
+            "-n",
+            "256",
+            "-d",
+            "4",
+            "--dims",
+            "0,2",
+            "--integrand",
+            "disk:r=0.3",
+            "--method",
+            "spatial",
+            "--json",
+        ]);
+        let stderr = grid["spatial"]["stderr"].as_f64();
+        let value = grid["spatial"]["variance"].as_f64().unwrap();
+        assert!(
+            stderr.is_some_and(|e| e <= 1e-12 * value),
+            "{sampler}: {grid}"
+        );
+        assert_eq!(
+            grid["spatial"]["sets"].as_u64(),
+            Some(16),
+            "{sampler}: {grid}"
+        );
+    }
 }

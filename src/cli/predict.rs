@@ -349,9 +349,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // on as many sets as reach it (variance::sets).
     let mut drawn = Vec::new();
     // A sampler's sets vary from draw to draw unless they are shifts of one
-    // lattice (regular, uniform jitter, lattices), whose spatial values agree.
+    // set (regular, uniform jitter, lattices), whose spatial values agree.
     let random_sets =
-        matches!(&source, Source::Sampler { sampler, .. } if sampler.lattice().is_none());
+        matches!(&source, Source::Sampler { sampler, .. } if !sampler.shifts_of_one_set());
     if wants(MethodArg::Fourier) || wants(MethodArg::Spatial) || wants(MethodArg::Radial) {
         drawn = source.realizations()?;
         let relative = set_forms(&a, f.as_ref(), &drawn, random_sets, &wants, &mut out)?;
@@ -383,20 +383,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     "wanted": count.wanted, "capped": count.capped(),
                 }),
             );
+            let most = format!(
+                "drew {} sets, the most the default work allows (R·N² ≤ 2^30 point pairs, \
+                 256 MiB of sets)",
+                count.sets
+            );
             if unseen && count.sets > pilot {
                 eprintln!(
                     "note: {pilot} random sets gave one spatial value (no spread: what varies \
                      between sets, such as pairs within a small integrand's reach, did not occur \
-                     in them); drew {} sets, the most the default work allows (R·N² ≤ 2^30 point \
-                     pairs, 256 MiB of sets); --sets fixes the count",
-                    count.sets
+                     in them); {most}; --sets fixes the count"
                 );
             } else if count.sets > pilot || count.capped() {
                 let drew = if count.capped() {
                     format!(
-                        "drew {} sets, the most the default work allows (R·N² ≤ 2^30 point \
-                         pairs, 256 MiB of sets): --sets {} reaches {:.0}%",
-                        count.sets,
+                        "{most}: --sets {} reaches {:.0}%",
                         count.wanted,
                         100.0 * TARGET_RELATIVE_STDERR
                     )
@@ -671,32 +672,31 @@ fn set_forms(
         });
         bar.finish_and_clear();
         let value = match spatial {
-            Ok(e) if random_sets && no_spread(e.variance, e.stderr, e.rounding_bound, e.sets) => {
-                // Every random set gave the same value: what varies between
-                // sets (pairs within the integrand's reach) was not seen,
-                // so the spread says nothing; the automatic count draws
-                // as many sets as it may.
-                relative = Some(f64::INFINITY);
-                json!({
-                "variance": e.variance, "stderr": Value::Null,
-                "stderr_unknown": format!(
-                    "all {} sets gave the same value: what varies between random sets (for \
-                     an integrand of small support, pairs closer than its reach) did not occur \
-                     in them, so their spread of 0 is no standard error; draw more with \
-                     --sets, or use --method expected where the sampler has a closed form",
-                    e.sets
-                ),
-                "rounding_bound": e.rounding_bound,
-                "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
-                })
-            }
             Ok(e) => {
-                note(e.variance, e.stderr, e.rounding_bound, e.sets);
-                json!({
+                let mut value = json!({
                 "variance": e.variance, "stderr": known_stderr(e.stderr, e.sets),
                 "rounding_bound": e.rounding_bound,
                 "sets": e.sets, "seconds": start.elapsed().as_secs_f64(),
-                })
+                });
+                if random_sets && no_spread(e.variance, e.stderr, e.rounding_bound, e.sets) {
+                    // Every random set gave the same value: what varies
+                    // between sets (pairs within the integrand's reach) was
+                    // not seen, so the spread says nothing; the automatic
+                    // count draws as many sets as it may.
+                    relative = Some(f64::INFINITY);
+                    value["stderr"] = Value::Null;
+                    value["stderr_unknown"] = json!(format!(
+                        "all {} sets gave the same value: what varies between random sets (for \
+                         an integrand of small support, pairs closer than its reach) did not \
+                         occur in them, so their spread of 0 is no standard error; draw more \
+                         with --sets, or use --method expected where the sampler has a closed \
+                         form",
+                        e.sets
+                    ));
+                } else {
+                    note(e.variance, e.stderr, e.rounding_bound, e.sets);
+                }
+                value
             }
             Err(e @ VarianceError::NoAutocovariance { .. }) => {
                 json!({"variance": Value::Null, "skipped": e.to_string()})

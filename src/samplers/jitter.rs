@@ -124,6 +124,11 @@ impl Sampler for Jitter {
             c: self.m,
         })
     }
+
+    /// The regular grid and uniform jitter in any dimension.
+    fn shifts_of_one_set(&self) -> bool {
+        self.offset != StratumOffset::Independent
+    }
 }
 
 /// One point per cell of the m×m grid (2D): with μ_s(ω) = E[e^(2πiω·q_s)]

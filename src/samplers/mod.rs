@@ -75,6 +75,13 @@ pub trait Sampler: Send + Sync {
     fn lattice(&self) -> Option<Lattice> {
         None
     }
+    /// True when every realization is a shift of one set (the regular grid
+    /// and uniform jitter in any dimension, the lattice rule): the
+    /// shift-randomized estimator then has the same variance on every set,
+    /// so a spread of zero between sets is exact, not a sign of too few.
+    fn shifts_of_one_set(&self) -> bool {
+        self.lattice().is_some()
+    }
     /// What a user should know about this instance that its name does not
     /// say (a multi-jittered set of N with no divisor near √N is a thin
     /// grid that stratifies like N-rooks); `None` when nothing. A padded
