@@ -1064,7 +1064,7 @@ fn sizes_beyond_memory_are_refused_before_allocating() {
                 "255",
             ],
             None,
-            "the closed-form expected power on the 255^4 frequency box (|k| <= 127) needs about 96777 MiB",
+            "the closed-form expected power on the 255^4 frequency box (|k| <= 127) needs about 161295 MiB",
         ),
         (
             vec![
@@ -1102,8 +1102,8 @@ fn sizes_beyond_memory_are_refused_before_allocating() {
             Some("1"),
             "more than the 1 MiB available (VARSPEC_MEMORY_MIB overrides the limit)",
         ),
-        // The closed form is estimated by its own arrays, 24 bytes per
-        // frequency: 8001² of them is 1466 MiB (it was refused as a
+        // The closed form is estimated by its own arrays, at most 40 bytes
+        // per frequency: 8001² of them is 2443 MiB (it was refused as a
         // non-uniform FFT needing 34028 MiB, a transform it never runs).
         (
             vec![
@@ -1118,7 +1118,7 @@ fn sizes_beyond_memory_are_refused_before_allocating() {
                 "expected",
             ],
             Some("1000"),
-            "the closed-form expected power on the 8001^2 frequency box (|k| <= 4000) needs about 1466 MiB",
+            "the closed-form expected power on the 8001^2 frequency box (|k| <= 4000) needs about 2443 MiB",
         ),
     ] {
         let out = run(&args, limit);
