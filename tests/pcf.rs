@@ -123,9 +123,11 @@ fn a_random_count_process_takes_its_radii_from_its_density() {
 }
 
 /// With few points in 4D the default range (2.5 packing distances) would
-/// reach half the torus: it shrinks to 99% of the largest that does not
-/// (0.782 r_max for N = 256, σ = 0.15), with a note; a range given is kept
-/// or refused, never changed.
+/// reach half the torus (1.682 r_max for N = 256): range and bandwidth
+/// shrink together, range = 10σ = 0.99·(1.682 − 6σ), σ = 0.99·1.682/15.94
+/// = 0.1045, with a note (the range alone shrank to 0.774 r_max, short of
+/// the nearest-neighbour peak at 1); a range given is kept or refused,
+/// never changed.
 #[test]
 fn the_default_range_fits_the_torus_and_a_given_one_is_kept() {
     let dir = crate::common::temp_dir("pcf-range");
@@ -133,7 +135,8 @@ fn the_default_range_fits_the_torus_and_a_given_one_is_kept() {
     let base = ["pcf", "--sampler", "umj", "-n", "256", "--sets", "4"];
     let out = crate::common::varspec_ok(&[&base[..], &["--csv", csv.to_str().unwrap()]].concat());
     assert!(
-        String::from_utf8_lossy(&out.stderr).contains("note: --range 0.774 r_max (not 2.5)"),
+        String::from_utf8_lossy(&out.stderr)
+            .contains("note: --range 1.045 r_max (not 2.5) and --bandwidth 0.1045 (not 0.15)"),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
@@ -147,7 +150,10 @@ fn the_default_range_fits_the_torus_and_a_given_one_is_kept() {
         .unwrap()
         .parse()
         .unwrap();
-    assert!((r_rel - 0.99 * 0.782).abs() < 2e-3, "{r_rel}");
+    assert!(
+        (r_rel - 10.0 * 0.99 * 1.682 / 15.94).abs() < 2e-3,
+        "{r_rel}"
+    );
     crate::common::assert_fails(
         &[&base[..], &["--range", "2.5"]].concat(),
         "lower --range to below 0.782",
@@ -157,9 +163,10 @@ fn the_default_range_fits_the_torus_and_a_given_one_is_kept() {
 
 /// Where even a range down to the bandwidth would reach half the torus
 /// (N = 4 in 2D: half the torus is 0.931 r_max, and 6 default kernel
-/// widths alone take 0.9), the default range and bandwidth shrink by one
-/// factor, 0.99·0.931/3.4 (the note was documented, but the command
-/// refused instead); a bandwidth given is kept, and then refused.
+/// widths alone take 0.9), the default range and bandwidth shrink
+/// together, range = 10σ, σ = 0.99·0.931/15.94 (the note was documented,
+/// but the command refused instead); a bandwidth given is kept, and then
+/// refused.
 #[test]
 fn few_points_shrink_the_default_bandwidth_with_the_range() {
     let dir = crate::common::temp_dir("pcf-few");
@@ -169,7 +176,7 @@ fn few_points_shrink_the_default_bandwidth_with_the_range() {
     let note = String::from_utf8_lossy(&out.stderr);
     // r_max = √(2/(√3·4)) = 0.537285, half the torus 0.930605 r_max.
     assert!(
-        note.contains("--range 0.677 r_max (not 2.5) and --bandwidth 0.0406 (not 0.15)"),
+        note.contains("--range 0.578 r_max (not 2.5) and --bandwidth 0.0578 (not 0.15)"),
         "{note}"
     );
     crate::common::assert_fails(

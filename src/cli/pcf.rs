@@ -21,8 +21,8 @@ pub struct Args {
     #[command(flatten)]
     source: SourceArgs,
     /// Largest radius, in units of the densest-packing distance r_max
-    /// [default: 2.5, or less where that would reach half the torus (few
-    /// points in 3D or 4D)].
+    /// [default: 2.5, or less, with the bandwidth, where that would reach
+    /// half the torus (few points)].
     #[arg(long)]
     range: Option<f64>,
     /// Radii evaluated in (0, range].
@@ -30,7 +30,7 @@ pub struct Args {
     bins: usize,
     /// Gaussian kernel standard deviation σ, in units of r_max [default:
     /// 0.15, or less, with the range, where the default range would reach
-    /// half the torus].
+    /// half the torus (few points)].
     #[arg(long)]
     bandwidth: Option<f64>,
     /// CSV output: r,r_rel,g (r_rel = r / r_max). Default: standard output.
@@ -46,6 +46,10 @@ const DEFAULT_RANGE: f64 = 2.5;
 
 /// `--bandwidth` when not given, where the default range fits the torus.
 const DEFAULT_BANDWIDTH: f64 = 0.15;
+
+/// The fewest kernel widths a shrunk default range spans: below it the
+/// bandwidth shrinks with the range.
+const MIN_RANGE_IN_BANDWIDTHS: f64 = 10.0;
 
 pub fn run(a: Args) -> anyhow::Result<()> {
     super::args::check_outputs_beside([a.csv.as_deref(), a.png.as_deref()], [a.source.file()])?;
@@ -91,15 +95,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let half = 0.5 / unit;
     let mut largest = half - KERNEL_REACH * bandwidth;
     if given.is_none() && range >= largest {
-        // The range alone while it stays above the bandwidth; below that
-        // (N ≤ 4 in 2D, ≤ 32 in 4D), with the bandwidth at its default
-        // too, both shrink by one factor (the default's σ = range/16.7).
+        // The range alone while it spans MIN_RANGE_IN_BANDWIDTHS kernel
+        // widths (and always with a given bandwidth); below that, with the
+        // bandwidth at its default, both shrink keeping that ratio:
+        // range = 0.99·(half − 6σ) = q·σ, continuous in N where the two
+        // meet (the range alone reached down to the bandwidth, then jumped
+        // up to 16.7 bandwidths: 0.76 r_max at N = 5 in 2D, 0.24 at 6).
+        let q = MIN_RANGE_IN_BANDWIDTHS;
         let (shrunk_range, shrunk_bandwidth) =
-            if 0.99 * largest >= bandwidth || a.bandwidth.is_some() {
+            if 0.99 * largest >= q * bandwidth || a.bandwidth.is_some() {
                 (0.99 * largest, bandwidth)
             } else {
-                let scale = 0.99 * half / (DEFAULT_RANGE + KERNEL_REACH * DEFAULT_BANDWIDTH);
-                (DEFAULT_RANGE * scale, DEFAULT_BANDWIDTH * scale)
+                let sigma = 0.99 * half / (q + 0.99 * KERNEL_REACH);
+                (q * sigma, sigma)
             };
         if shrunk_range >= shrunk_bandwidth && shrunk_bandwidth >= 1e-3 {
             let narrower = shrunk_bandwidth < bandwidth;
