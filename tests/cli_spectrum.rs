@@ -70,6 +70,25 @@ fn xu_projection_equals_the_spectrum_of_the_xu_columns() {
     );
     assert_eq!(a.lines().count(), 31 * 31);
     assert_eq!(a, b);
+    // Dimensions past the fourth are named by index, never twice `k`.
+    let c = dir.join("c.csv");
+    ok(&varspec(&[
+        "spectrum",
+        "--sampler",
+        "random",
+        "-d",
+        "6",
+        "-n",
+        "16",
+        "--dims",
+        "4,5",
+        "--res",
+        "5",
+        "--csv",
+        s(&c),
+    ]));
+    let c = std::fs::read_to_string(&c).unwrap();
+    assert!(c.starts_with("k4,k5,power\n"), "{}", &c[..20]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -116,15 +116,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     )?;
     let freqs = FrequencyBox::from_resolution(2, a.res);
     let plane = a.source.plane()?;
-    let axes = match plane {
-        Some(dims) => dims.map(|d| AXES.get(d).copied().unwrap_or("k")),
-        None => ["kx", "ky"],
-    };
-    // A projection's title names its plane (XU for dims 0,2).
+    // Dimensions past the fourth are named by their index (k4, k5), so
+    // that no two columns share a name.
+    let axes = plane
+        .unwrap_or([0, 1])
+        .map(|d| AXES.get(d).map_or(format!("k{d}"), |a| (*a).to_string()));
+    // A projection's title names its plane (XU for dims 0,2; X4X5).
     let plane_name = plane.map_or(String::new(), |_| {
         let name: String = axes
             .iter()
-            .map(|a| a.trim_start_matches('k').to_uppercase())
+            .map(|a| match a.trim_start_matches('k') {
+                letter if letter.parse::<usize>().is_err() => letter.to_uppercase(),
+                index => format!("X{index}"),
+            })
             .collect();
         format!(", {name} plane")
     });
@@ -194,7 +198,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             let mut k = [0i64; 2];
             write_csv_headed(
                 w,
-                &[axes[0], axes[1], "power"],
+                &[&axes[0], &axes[1], "power"],
                 spectrum.power.iter().enumerate().map(|(idx, &power)| {
                     freqs.frequency(idx, &mut k);
                     (k[0], k[1], power)
@@ -210,7 +214,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         write_atomic(path, radial_csv)?;
     }
     if let Some(path) = &a.png {
-        power_png(&spectrum, &title, axes, bar_label, path)?;
+        power_png(&spectrum, &title, [&axes[0], &axes[1]], bar_label, path)?;
     }
     if let Some(path) = &a.radial_png {
         let plot = LinePlot {
