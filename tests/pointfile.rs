@@ -151,6 +151,32 @@ fn every_malformed_input_names_its_line() {
             |p| matches!(p, LineProblem::OutOfRange { field: 2, .. }),
             "`0.99999999999999995`, which rounds to the double 1,",
         ),
+        // Whatever its spelling (these read as "field 2 is 1": review).
+        (
+            "x0,x1\n0.1,.99999999999999995\n",
+            2,
+            |p| matches!(p, LineProblem::OutOfRange { field: 2, .. }),
+            "`.99999999999999995`, which rounds to the double 1,",
+        ),
+        (
+            "x0,x1\n0.1,9.9999999999999999e-1\n",
+            2,
+            |p| matches!(p, LineProblem::OutOfRange { field: 2, .. }),
+            "`9.9999999999999999e-1`, which rounds to the double 1,",
+        ),
+        // Spellings of exactly 1 are 1.
+        (
+            "x0,x1\n0.1,10e-1\n",
+            2,
+            |p| matches!(p, LineProblem::OutOfRange { field: 2, .. }),
+            "field 2 is 1, outside",
+        ),
+        (
+            "x0,x1\n0.1,0.0100E2\n",
+            2,
+            |p| matches!(p, LineProblem::OutOfRange { field: 2, .. }),
+            "field 2 is 1, outside",
+        ),
         (
             "x0,x1\n0.1,0.2\n0.3\n",
             3,

@@ -157,11 +157,12 @@ impl fmt::Display for LineProblem {
                 write!(f, "field {field} is `{text}`, not a finite number")
             }
             LineProblem::OutOfRange { field, value, text } if *value == 1.0 => {
-                // 0.99999999999999995 reads as the double 1.
-                let rounds = if text.trim_start_matches('+').starts_with("0.") {
-                    format!("`{text}`, which rounds to the double 1,")
-                } else {
+                // 0.99999999999999995 (or .99999999999999995, or
+                // 9.9999999999999999e-1) reads as the double 1.
+                let rounds = if decimal_is_one(text) {
                     "1,".to_string()
+                } else {
+                    format!("`{text}`, which rounds to the double 1,")
                 };
                 write!(
                     f,
@@ -694,4 +695,24 @@ pub fn write_point_sets(
         }
     }
     Ok(())
+}
+
+/// True when the decimal `text` (as f64 parsing accepts it: sign, digits,
+/// point, exponent) is exactly 1, not merely a number that rounds to it.
+fn decimal_is_one(text: &str) -> bool {
+    let text = text.trim().trim_start_matches('+');
+    let (mantissa, exponent) = match text.split_once(['e', 'E']) {
+        Some((m, e)) => match e.parse::<i64>() {
+            Ok(e) => (m, e),
+            Err(_) => return false,
+        },
+        None => (text, 0),
+    };
+    let (int, frac) = mantissa.split_once('.').unwrap_or((mantissa, ""));
+    let digits = format!("{int}{frac}");
+    let significant = digits.trim_start_matches('0');
+    let trimmed = significant.trim_end_matches('0');
+    // digits·10^(exponent − |frac|); trailing zeros raise the power.
+    let power = exponent - frac.len() as i64 + (significant.len() - trimmed.len()) as i64;
+    trimmed == "1" && power == 0
 }
