@@ -698,6 +698,17 @@ fn a_bad_report_option_fails_before_any_work_and_leaves_no_folder() {
         "--integrand",
     );
     assert!(!out.exists(), "a failed report left {}", out.display());
+    // A folder that cannot be created is named (it said only "Not a
+    // directory": trial).
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("afile");
+    std::fs::write(&file, "").unwrap();
+    let under = file.join("sub");
+    common::assert_fails(
+        &["report", "-o", under.to_str().unwrap()],
+        &format!("creating the report folder: {}", under.display()),
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

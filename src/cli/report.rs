@@ -53,7 +53,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map_or("?", |r| r.sampler.as_str());
     announce!(
         "wrote {} in {:.1} s: lowest variance on {} at N = {}: {best}; square design {:.2}x CMJ on half-planes; \
-         shear ({:.3}, {:.3}) for c = {:.2}, {:.1}x lower",
+         shear ({:.3}, {:.3}) for c = {}, {:.1}x lower",
         a.output.join("index.html").display(),
         tour.seconds,
         tour.predict.integrand,
@@ -61,7 +61,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         tour.square.halfplanes_against("cmj").unwrap_or(f64::NAN),
         tour.shear.shear[0],
         tour.shear.shear[1],
-        -tour.shear.analytic,
+        tour.shear
+            .analytic
+            .iter()
+            .map(|a| format!("{:.2}", -a[0]))
+            .collect::<Vec<_>>()
+            .join(" and "),
         tour.shear.reduction
     );
     Ok(())

@@ -20,8 +20,10 @@ use super::Integrand;
 pub fn check_plane(dims: [usize; 2], dim: usize) -> Result<(), SpectrumError> {
     if dims[0] == dims[1] || dims.iter().any(|&d| d >= dim) {
         return Err(SpectrumError::Plane(format!(
-            "the plane must be two distinct coordinates of 0..{dim} (a {dim}-dimensional integrand), not {},{}",
-            dims[0], dims[1]
+            "the plane must be two distinct coordinates of 0 to {} (a {dim}-dimensional integrand), not {},{}",
+            dim.saturating_sub(1),
+            dims[0],
+            dims[1]
         )));
     }
     Ok(())

@@ -196,8 +196,9 @@ pub struct ShearSection {
     pub initial: [f64; 2],
     /// J there.
     pub initial_value: f64,
-    /// Analytic shear −c.
-    pub analytic: f64,
+    /// Analytic shear (−c, −c) of each layer of the light field (two for
+    /// `layers`: a double wedge, which no single shear follows).
+    pub analytic: Vec<[f64; 2]>,
     /// J at (0, 0).
     pub unsheared: f64,
     /// J at the optimum.
@@ -624,7 +625,7 @@ fn shear_section(o: &TourOptions) -> Result<ShearSection, TourError> {
     let f = integrands::parse(&o.pixel).map_err(at("the pixel"))?;
     let analytic = f
         .light_field()
-        .map(|l| l.layer_shears()[0][0])
+        .map(|l| l.layer_shears())
         .ok_or_else(|| at("the pixel")("not a light field"))?;
     let umj = registry::build("umj", n, Some(4), &[]).map_err(at("umj"))?;
     // The search and its check as `optimize shear` runs them (defaults:
