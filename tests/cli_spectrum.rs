@@ -310,7 +310,10 @@ fn an_integrands_power_is_its_closed_form_and_a_4d_one_is_drawn_on_a_plane() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--dims"));
     let out = varspec(&["spectrum", "--integrand", "disk:r=0.3", "--dims", "0,2"]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("two distinct coordinates of 0 to 1 (a 2-dimensional integrand), not 0,2"));
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .contains("two distinct coordinates of 0 to 1 (a 2-dimensional integrand), not 0,2")
+    );
     let out = varspec(&["spectrum"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--integrand"));

@@ -63,6 +63,13 @@ impl Target {
                 .map_err(fail);
         }
         match integrands::parse(spec) {
+            // Every set integrates a constant exactly: the descent would
+            // report a loss of 0 and "improve" nothing.
+            Ok(f) if f.variance() == 0.0 => Err(fail(
+                "the integrand is constant (variance 0): every point set integrates it exactly, \
+                 so there is nothing to design for; give one that varies"
+                    .into(),
+            )),
             Ok(_) => Ok(Target::Integrand(spec.to_string())),
             Err(integrands::IntegrandError::Unknown { name, .. })
                 if name
@@ -328,6 +335,13 @@ mod tests {
             Ok(Target::Integrand(_))
         ));
         assert!(Target::parse("disk:r=0.7").is_err());
+        // Constant integrands leave nothing to design for.
+        for constant in ["cos:kx=0,ky=0", "box:w=1,h=1"] {
+            assert!(
+                matches!(Target::parse(constant), Err(OptimizeError::Target { ref reason, .. }) if reason.contains("constant")),
+                "{constant}"
+            );
+        }
     }
 
     #[test]
