@@ -1219,21 +1219,25 @@ fn converge_on_a_plane_fits_the_projection() {
 /// outside the project); checked at 99.9% (z ≤ 3.29).
 #[test]
 fn random_sets_with_no_spread_have_no_standard_error() {
-    let args = [
-        "predict",
-        "--sampler",
-        "jitter",
-        "-n",
-        "256",
-        "--integrand",
-        "disk:r=1e-3",
-        "--method",
-        "spatial",
-        "--json",
-    ];
-    let mut fixed = args.to_vec();
-    fixed.extend(["--sets", "16"]);
-    let pilot = json(&fixed);
+    // `predict --method spatial --json` of `sampler` on `integrand`, with
+    // the extra options.
+    let args = |sampler: &'static str, integrand: &'static str, extra: &[&'static str]| {
+        let mut args = vec![
+            "predict",
+            "--sampler",
+            sampler,
+            "-n",
+            "256",
+            "--integrand",
+            integrand,
+            "--method",
+            "spatial",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        args
+    };
+    let pilot = json(&args("jitter", "disk:r=1e-3", &["--sets", "16"]));
     assert!(pilot["spatial"]["stderr"].is_null(), "{pilot}");
     assert!(
         pilot["spatial"]["stderr_unknown"]
@@ -1241,7 +1245,7 @@ fn random_sets_with_no_spread_have_no_standard_error() {
             .is_some_and(|s| s.contains("all 16 sets gave the same value")),
         "{pilot}"
     );
-    let out = varspec_ok(&args);
+    let out = varspec_ok(&args("jitter", "disk:r=1e-3", &[]));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let spatial = &v["spatial"];
     assert_eq!(spatial["sets"].as_u64(), Some(1024), "{v}");
@@ -1260,18 +1264,7 @@ fn random_sets_with_no_spread_have_no_standard_error() {
         String::from_utf8_lossy(&out.stderr)
     );
     // Shifts of one lattice agree by construction: their 0 stands.
-    let lattice = json(&[
-        "predict",
-        "--sampler",
-        "uniform-jitter",
-        "-n",
-        "256",
-        "--integrand",
-        "disk:r=1e-3",
-        "--method",
-        "spatial",
-        "--json",
-    ]);
+    let lattice = json(&args("uniform-jitter", "disk:r=1e-3", &[]));
     assert_eq!(
         lattice["spatial"]["stderr"].as_f64(),
         Some(0.0),
@@ -1280,22 +1273,7 @@ fn random_sets_with_no_spread_have_no_standard_error() {
     // So do the 4D grid's and uniform jitter's, projected (they were taken
     // for random sets: stderr null and 1024 sets drawn: review).
     for sampler in ["regular", "uniform-jitter"] {
-        let grid = json(&[
-            "predict",
-            "--sampler",
-            sampler,
-            "-n",
-            "256",
-            "-d",
-            "4",
-            "--dims",
-            "0,2",
-            "--integrand",
-            "disk:r=0.3",
-            "--method",
-            "spatial",
-            "--json",
-        ]);
+        let grid = json(&args(sampler, "disk:r=0.3", &["-d", "4", "--dims", "0,2"]));
         let stderr = grid["spatial"]["stderr"].as_f64();
         let value = grid["spatial"]["variance"].as_f64().unwrap();
         assert!(

@@ -304,17 +304,27 @@ fn integrand_constructors_refuse_what_their_closed_forms_cannot_hold() {
 /// (overlaps near 1 less A² near 1).
 #[test]
 fn boxes_of_area_near_one_keep_their_variance_digits() {
+    four_point_variances_match(
+        &[
+            ("box:w=1,h=0.99999999", 2.4999999125618973e-9),
+            ("box:w=0.99999999,h=0.99999999", 4.9999997501237975e-9),
+            ("box:w=1,h=0.3,angle=90", 0.010000000000000005),
+            ("box:w=0.3,h=0.2", 0.0114),
+        ],
+        1e-13,
+    );
+}
+
+/// The shift variance of the four points (0.1, 0.2), (0.6, 0.3),
+/// (0.35, 0.85), (0.9, 0.7) on each integrand, within `relative` of its
+/// exact value.
+fn four_point_variances_match(cases: &[(&str, f64)], relative: f64) {
     let coords = vec![0.1, 0.2, 0.6, 0.3, 0.35, 0.85, 0.9, 0.7];
     let set = varspec::points::PointSet::new(2, coords).unwrap();
-    for (spec, exact) in [
-        ("box:w=1,h=0.99999999", 2.4999999125618973e-9),
-        ("box:w=0.99999999,h=0.99999999", 4.9999997501237975e-9),
-        ("box:w=1,h=0.3,angle=90", 0.010000000000000005),
-        ("box:w=0.3,h=0.2", 0.0114),
-    ] {
+    for &(spec, exact) in cases {
         let (v, _) = varspec::variance::spatial_variance(&set, &*parse(spec)).unwrap();
         assert!(
-            (v - exact).abs() <= 1e-13 * exact,
+            (v - exact).abs() <= relative * exact,
             "{spec}: {v:e} against {exact:e} ({:.1e} relative)",
             (v - exact).abs() / exact
         );
@@ -331,22 +341,16 @@ fn boxes_of_area_near_one_keep_their_variance_digits() {
 /// (overlaps near 1 minus I² near 1).
 #[test]
 fn a_sliver_and_its_complement_keep_their_variance_digits() {
-    let coords = vec![0.1, 0.2, 0.6, 0.3, 0.35, 0.85, 0.9, 0.7];
-    let set = varspec::points::PointSet::new(2, coords).unwrap();
-    for (spec, exact) in [
-        ("halfplane:angle=135,offset=-0.707", 2.8505553201182595e-9),
-        ("halfplane:angle=45,offset=0.707", 2.850555320124187e-9),
-        ("halfplane:angle=17,offset=0.07", 0.019292486633437588),
-    ] {
-        let (v, _) = varspec::variance::spatial_variance(&set, &*parse(spec)).unwrap();
-        // The level's own rounding (about 2e-16 of a distance of 1.1e-4
-        // from the corner) moves the exact value by about 2e-12.
-        assert!(
-            (v - exact).abs() <= 1e-11 * exact,
-            "{spec}: {v:e} against {exact:e} ({:.1e} relative)",
-            (v - exact).abs() / exact
-        );
-    }
+    // The level's own rounding (about 2e-16 of a distance of 1.1e-4 from
+    // the corner) moves the exact value by about 2e-12.
+    four_point_variances_match(
+        &[
+            ("halfplane:angle=135,offset=-0.707", 2.8505553201182595e-9),
+            ("halfplane:angle=45,offset=0.707", 2.850555320124187e-9),
+            ("halfplane:angle=17,offset=0.07", 0.019292486633437588),
+        ],
+        1e-11,
+    );
     // The sliver's integral, exact for its f64 normal and level.
     let sliver = parse("halfplane:angle=45,offset=0.707");
     let exact = 1.1402221800539396e-8;
