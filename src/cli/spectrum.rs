@@ -64,8 +64,15 @@ pub struct Args {
     radial_png: Option<PathBuf>,
 }
 
-/// Frequency axis names of the coordinates x, y, u, v.
-const AXES: [&str; 4] = ["kx", "ky", "ku", "kv"];
+/// The names of coordinate `d`'s frequency axis and of the coordinate in a
+/// plane's title: kx/X, ky/Y, ku/U, kv/V, then by index (k4/X4, so that no
+/// two columns share a name).
+fn axis_names(d: usize) -> (String, String) {
+    match ["x", "y", "u", "v"].get(d) {
+        Some(letter) => (format!("k{letter}"), letter.to_uppercase()),
+        None => (format!("k{d}"), format!("X{d}")),
+    }
+}
 
 /// P_f of the integrand `spec` on `plane` (a 2D integrand's own plane by
 /// default) on |k|∞ ≤ `half`, and its name.
@@ -116,22 +123,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     )?;
     let freqs = FrequencyBox::from_resolution(2, a.res);
     let plane = a.source.plane()?;
-    // Dimensions past the fourth are named by their index (k4, k5), so
-    // that no two columns share a name.
-    let axes = plane
-        .unwrap_or([0, 1])
-        .map(|d| AXES.get(d).map_or(format!("k{d}"), |a| (*a).to_string()));
+    let [(kx, x), (ky, y)] = plane.unwrap_or([0, 1]).map(axis_names);
+    let axes = [kx.as_str(), ky.as_str()];
     // A projection's title names its plane (XU for dims 0,2; X4X5).
-    let plane_name = plane.map_or(String::new(), |_| {
-        let name: String = axes
-            .iter()
-            .map(|a| match a.trim_start_matches('k') {
-                letter if letter.parse::<usize>().is_err() => letter.to_uppercase(),
-                index => format!("X{index}"),
-            })
-            .collect();
-        format!(", {name} plane")
-    });
+    let plane_name = plane.map_or(String::new(), |_| format!(", {x}{y} plane"));
     let (spectrum, title, bar_label) = match &a.integrand {
         Some(spec) => {
             let (power, name) = integrand_power(spec, plane, freqs.half, a.source.seed())?;
@@ -198,7 +193,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             let mut k = [0i64; 2];
             write_csv_headed(
                 w,
-                &[&axes[0], &axes[1], "power"],
+                &[axes[0], axes[1], "power"],
                 spectrum.power.iter().enumerate().map(|(idx, &power)| {
                     freqs.frequency(idx, &mut k);
                     (k[0], k[1], power)
@@ -214,7 +209,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         write_atomic(path, radial_csv)?;
     }
     if let Some(path) = &a.png {
-        power_png(&spectrum, &title, [&axes[0], &axes[1]], bar_label, path)?;
+        power_png(&spectrum, &title, axes, bar_label, path)?;
     }
     if let Some(path) = &a.radial_png {
         let plot = LinePlot {

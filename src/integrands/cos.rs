@@ -68,7 +68,11 @@ impl Integrand for Cosine {
     }
 
     fn autocov(&self, h: &[f64]) -> Option<f64> {
-        self.autocov_between(h, &[0.0, 0.0])
+        Some(if self.constant() {
+            0.0
+        } else {
+            0.5 * cos_turns(self.phase(h))
+        })
     }
 
     fn autocov_between(&self, x: &[f64], y: &[f64]) -> Option<f64> {

@@ -27,7 +27,7 @@ pub use layers::Layers;
 pub use light_field::{LightField, PlaneWave, energy as light_field_energy};
 pub use plane_power::{check_plane, plane_power};
 pub use rect::Rect;
-pub use spec::{INTEGRANDS, IntegrandInfo, parse};
+pub use spec::{INTEGRANDS, IntegrandInfo, parse, scene_pixel_rest};
 
 use rustfft::num_complex::Complex64;
 

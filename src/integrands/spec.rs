@@ -222,6 +222,17 @@ impl Params {
     }
 }
 
+/// The name of a scene-pixel spec (`scene:NAME,px=X,py=Y`, parsed by
+/// `scene::pixel`, not here).
+const SCENE_PIXEL: &str = "scene";
+
+/// What follows `scene:` in a scene-pixel spec (whitespace around `scene`
+/// ignored, as around every name); `None` for any other spec.
+pub fn scene_pixel_rest(spec: &str) -> Option<&str> {
+    spec.split_once(':')
+        .and_then(|(head, rest)| (head.trim() == SCENE_PIXEL).then_some(rest))
+}
+
 /// Parses `name:key=value,...` (or just `name`) into an integrand.
 ///
 /// # Errors
@@ -237,7 +248,7 @@ pub fn parse(spec: &str) -> Result<Box<dyn Integrand>, IntegrandError> {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    if name == "scene" {
+    if name == SCENE_PIXEL {
         return Err(IntegrandError::ScenePixel { known: known() });
     }
     let info =

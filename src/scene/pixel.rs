@@ -67,8 +67,7 @@ impl PixelIntegrand {
     /// True for a spec this type parses (`scene:...`, whitespace around
     /// `scene` ignored as in every spec).
     pub fn is_pixel_spec(spec: &str) -> bool {
-        spec.split_once(':')
-            .is_some_and(|(head, _)| head.trim() == "scene")
+        crate::integrands::scene_pixel_rest(spec).is_some()
     }
 
     /// The files a pixel spec reads ([`Scene::files_read`] of its scene;
@@ -105,10 +104,8 @@ impl PixelIntegrand {
             spec: spec.into(),
             message,
         };
-        let rest = match spec.split_once(':') {
-            Some((head, rest)) if head.trim() == "scene" => rest,
-            _ => return Err(fail("no `scene:` prefix".into())),
-        };
+        let rest = crate::integrands::scene_pixel_rest(spec)
+            .ok_or_else(|| fail("no `scene:` prefix".into()))?;
         let (name, params) = rest
             .split_once(',')
             .ok_or_else(|| fail("no pixel given".into()))?;
