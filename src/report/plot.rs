@@ -360,7 +360,8 @@ pub struct HeatMap<'a> {
 }
 
 /// Writes a 2D power spectrum as a heat map centred at DC, log10 power in
-/// the viridis colour map with a labelled colour bar (760×640 PNG).
+/// the viridis colour map with a labelled colour bar (760×640 PNG, square
+/// cells).
 ///
 /// The colour range spans the powers at k ≠ 0: from the largest down at
 /// most four decades; DC (power N, off any useful scale) is drawn grey,
@@ -442,8 +443,9 @@ fn power_colour_range(logs: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
-/// Writes `map` as a 760×640 PNG (viridis, colour bar on the right),
-/// atomically.
+/// Writes `map` as a PNG (viridis, colour bar on the right), atomically,
+/// with square cells: about 760×640 for a square grid, shorter for a wide
+/// one, narrower for a tall one (see [`frame_for_square_cells`]).
 ///
 /// # Errors
 /// [`Error::Write`] naming `path` (also for an empty or ragged grid and for
@@ -464,10 +466,10 @@ pub fn heatmap_png(map: &HeatMap, path: &Path) -> Result<(), Error> {
     }
     ensure_font();
     let (lo, hi) = colour_span(map.colour_range);
-    let (w, h) = (760u32, 640u32);
+    let (cols, rows) = (map.width, map.values.len() / map.width);
+    let (w, h) = frame_for_square_cells(map, cols as f64 / rows as f64).map_err(fail)?;
     let mut buf = vec![255u8; (w * h * 3) as usize];
     let (heat, bar) = draw_heatmap_frame(map, &mut buf, (w, h)).map_err(fail)?;
-    let (cols, rows) = (map.width, map.values.len() / map.width);
     let colour = |v: f64| {
         if v.is_nan() {
             RGBColor(128, 128, 128)
@@ -502,6 +504,35 @@ pub fn heatmap_png(map: &HeatMap, path: &Path) -> Result<(), Error> {
 
 type PixelRange = (std::ops::Range<i32>, std::ops::Range<i32>);
 
+/// The picture's width and height that make a `cols`/`rows` grid of
+/// aspect `aspect` draw with square cells (a rendered image of 2:1, a 16:9
+/// frame), instead of stretched into the default 760×640 frame: a wide grid
+/// shortens the picture, a tall one narrows it. The frame's margins, labels
+/// and colour bar are measured, not assumed (a narrower picture may shrink
+/// its title, which moves the plot), so the fit is repeated until the plot
+/// is within a pixel of the aspect. Aspects beyond 1:4 and 4:1 are clamped
+/// there (the colour bar keeps room for its ticks), so only such extreme
+/// grids get oblong cells.
+fn frame_for_square_cells(map: &HeatMap, aspect: f64) -> std::io::Result<(u32, u32)> {
+    let aspect = aspect.clamp(0.25, 4.0);
+    let (mut w, mut h) = (760u32, 640u32);
+    for _ in 0..4 {
+        let mut probe = vec![255u8; (w * h * 3) as usize];
+        let ((px, py), _) = draw_heatmap_frame(map, &mut probe, (w, h))?;
+        let (pw, ph) = (f64::from(px.end - px.start), f64::from(py.end - py.start));
+        let (too_tall, too_wide) = (ph - pw / aspect, pw - ph * aspect);
+        if too_tall.abs() < 1.0 && too_wide.abs() < 1.0 {
+            break;
+        }
+        if aspect >= pw / ph {
+            h = (f64::from(h) - too_tall).round() as u32;
+        } else {
+            w = (f64::from(w) - too_wide).round() as u32;
+        }
+    }
+    Ok((w, h))
+}
+
 /// A colour range that spans something: a constant field (every pixel's
 /// shear 0) gets v ± 1 instead of a bar whose ticks all read the same.
 fn colour_span((lo, hi): (f64, f64)) -> (f64, f64) {
@@ -527,8 +558,6 @@ fn tick_number(v: f64) -> String {
     }
 }
 
-/// Draws axes, labels and colour-bar ticks; returns the pixel ranges of the
-/// heat map and the colour bar, which the caller fills.
 /// The largest title size up to 22 px whose text fits the picture's width
 /// (a long title, such as a scene figure's, was clipped at both ends).
 fn title_size<DB: DrawingBackend>(
@@ -546,6 +575,8 @@ fn title_size<DB: DrawingBackend>(
     size
 }
 
+/// Draws axes, labels and colour-bar ticks; returns the pixel ranges of the
+/// heat map and the colour bar, which the caller fills.
 fn draw_heatmap_frame(
     map: &HeatMap,
     buf: &mut [u8],
@@ -603,6 +634,46 @@ fn draw_heatmap_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The plot area a heat map of `cols` × `rows` cells is drawn into, in
+    /// pixels, measured from the drawn frame.
+    fn plot_area(cols: usize, rows: usize) -> (f64, f64) {
+        let values = vec![0.0; cols * rows];
+        let map = HeatMap {
+            title: "a title as long as a render's: variance over 16 renders".into(),
+            values: &values,
+            width: cols,
+            x_range: (0.0, cols as f64),
+            y_range: (rows as f64, 0.0),
+            x_label: "pixel x".into(),
+            y_label: "pixel y".into(),
+            bar_label: "log10 variance".into(),
+            colour_range: (0.0, 1.0),
+        };
+        ensure_font();
+        let (w, h) = frame_for_square_cells(&map, cols as f64 / rows as f64).unwrap();
+        let mut buf = vec![255u8; (w * h * 3) as usize];
+        let ((px, py), _) = draw_heatmap_frame(&map, &mut buf, (w, h)).unwrap();
+        (f64::from(px.end - px.start), f64::from(py.end - py.start))
+    }
+
+    #[test]
+    fn heat_map_cells_are_square_at_any_aspect() {
+        // The plot area of the default 760×640 frame is 0.94:1; a 2:1 render
+        // was stretched into it. One pixel of slack on each side.
+        for (cols, rows) in [(256, 256), (192, 96), (640, 360), (64, 160), (100, 400)] {
+            let (pw, ph) = plot_area(cols, rows);
+            let want = cols as f64 / rows as f64;
+            assert!(
+                (pw - ph * want).abs() <= 1.0 + want && (ph - pw / want).abs() <= 1.0 + 1.0 / want,
+                "{cols}×{rows}: plot area {pw}×{ph} has aspect {}, not {want}",
+                pw / ph
+            );
+        }
+        // Beyond 4:1 the aspect is clamped (the colour bar needs height).
+        let (pw, ph) = plot_area(1000, 10);
+        assert!((pw / ph - 4.0).abs() < 0.05, "1000×10: {pw}×{ph}");
+    }
 
     #[test]
     fn power_colour_range_ends_at_the_largest_power() {
