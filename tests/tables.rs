@@ -801,10 +801,13 @@ fn a_table_converted_from_a_table_keeps_its_provenance() {
         "-o",
         &t("u.json"),
     ]);
+    varspec(&["tables", "--from", &t("u.json"), "-o", &t("u.h")]);
+    // The C header carries it in its comment (it lost it: `tables --from
+    // t.h` recorded the header's path as the source and no seed).
     varspec(&[
         "tables",
         "--from",
-        &t("u.json"),
+        &t("u.h"),
         "--format",
         "f64",
         "-o",
@@ -855,5 +858,21 @@ fn a_table_converted_from_a_table_keeps_its_provenance() {
     let stale = sidecar(Path::new(&t("c.f64")));
     assert_eq!((stale.seed, stale.sets), (None, 1));
     assert_eq!(stale.source, t("c.csv"));
+    // A source whose path holds `*/` does not close the header's comment
+    // early, and reads back as written.
+    std::fs::create_dir(d.join("a*")).unwrap();
+    std::fs::write(t("a*/p.csv"), "x0,x1\n0.25,0.5\n0.75,0.125\n").unwrap();
+    varspec(&["tables", "--from", &t("a*/p.csv"), "-o", &t("p.h")]);
+    let header = std::fs::read_to_string(t("p.h")).unwrap();
+    let comment_ends = header
+        .split("#ifndef")
+        .next()
+        .unwrap()
+        .matches("*/")
+        .count();
+    assert_eq!(comment_ends, 1, "{header}");
+    varspec(&["tables", "--from", &t("p.h"), "-o", &t("p.json")]);
+    let meta = crate::common::read_json(&d.join("p.json"))["metadata"].clone();
+    assert_eq!(meta["source"], t("a*/p.csv"), "{meta}");
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -281,7 +281,11 @@ pub fn read_point_sets_with_metadata(
         let mut text = String::new();
         reader.read_to_string(&mut text).map_err(io)?;
         return tables::read_c_header(&text)
-            .map(|sets| (sets, None))
+            .map(|sets| {
+                let meta = tables::read_c_header_metadata(&text)
+                    .filter(|meta| tables::describes(meta, &sets));
+                (sets, meta)
+            })
             .map_err(table);
     }
     let sets = parse_point_sets(reader, path).map_err(|e| match (e, &sidecar) {
