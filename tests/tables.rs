@@ -203,6 +203,7 @@ fn f32_tables_stay_below_one() {
         dim: 2,
         sets: 1,
         layout: String::new(),
+        values_digest: None,
         optimized_for: "none".into(),
         predicted_variance: vec![],
         dimensions: None,
@@ -858,6 +859,55 @@ fn a_table_converted_from_a_table_keeps_its_provenance() {
     let stale = sidecar(Path::new(&t("c.f64")));
     assert_eq!((stale.seed, stale.sets), (None, 1));
     assert_eq!(stale.source, t("c.csv"));
+    // Nor is a sidecar of the same shape left beside points written over
+    // its table (they were labelled `cmj (seed 3)`: new-user trial); the
+    // values' digest tells them apart, and a note says so.
+    varspec(&[
+        "tables",
+        "--sampler",
+        "cmj",
+        "-n",
+        "4",
+        "--sets",
+        "2",
+        "--seed",
+        "3",
+        "-o",
+        &t("c.csv"),
+    ]);
+    varspec(&[
+        "sample",
+        "random",
+        "-n",
+        "4",
+        "--sets",
+        "2",
+        "--seed",
+        "9",
+        "-o",
+        &t("c.csv"),
+    ]);
+    let note = varspec(&["tables", "--from", &t("c.csv"), "-o", &t("r.json")]);
+    let meta = crate::common::read_json(&d.join("r.json"))["metadata"].clone();
+    assert_eq!(
+        (&meta["source"], &meta["seed"]),
+        (&t("c.csv").into(), &serde_json::Value::Null),
+        "{meta}"
+    );
+    assert!(note.contains("does not describe"), "{note}");
+    // The input's sidecar is an input too: writing it is refused.
+    crate::common::assert_fails(
+        &[
+            "tables",
+            "--from",
+            &t("u.f32"),
+            "--format",
+            "json",
+            "-o",
+            &t("u.f32.json"),
+        ],
+        "is both an input and an output",
+    );
     // A source whose path holds `*/` does not close the header's comment
     // early, and reads back as written.
     std::fs::create_dir(d.join("a*")).unwrap();
@@ -874,5 +924,8 @@ fn a_table_converted_from_a_table_keeps_its_provenance() {
     varspec(&["tables", "--from", &t("p.h"), "-o", &t("p.json")]);
     let meta = crate::common::read_json(&d.join("p.json"))["metadata"].clone();
     assert_eq!(meta["source"], t("a*/p.csv"), "{meta}");
+    // FNV-1a 64 of the four values' binary64 bytes, computed in Python
+    // (struct.pack('<d', v), offset 0xcbf29ce484222325, prime 0x100000001b3).
+    assert_eq!(meta["values_digest"], "fnv1a64:3ace574b5a78264d", "{meta}");
     std::fs::remove_dir_all(&d).unwrap();
 }

@@ -104,9 +104,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let sidecar = format
         .needs_sidecar()
         .then(|| varspec::io::tables::sidecar_path(&a.output));
+    // So is the input's sidecar: `--from t.csv -o t.csv.json` replaced
+    // the provenance of the file it read.
+    let from_sidecar = a.from.as_deref().map(varspec::io::tables::sidecar_path);
     super::args::check_outputs_beside(
         [Some(a.output.as_path()), sidecar.as_deref()],
-        [a.from.as_deref()],
+        [a.from.as_deref(), from_sidecar.as_deref()],
     )?;
     let mut run_params = a.draw.params.clone();
     let mut run_seed = Some(a.draw.seed());
@@ -149,6 +152,17 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }
             run_seed = None;
             let (sets, meta) = read_point_sets_with_metadata(path)?;
+            if meta.is_none()
+                && let Some(stale) = from_sidecar.as_deref().filter(|p| p.is_file())
+            {
+                eprintln!(
+                    "note: {} does not describe {} (unreadable, or written for other points): \
+                     its provenance is not carried; the table records the file's path as its \
+                     source and no seed",
+                    stale.display(),
+                    path.display()
+                );
+            }
             carried = meta;
             (sets, path.display().to_string())
         }

@@ -245,8 +245,13 @@ pub fn read_point_sets_with_metadata(
     if let Some(Ok(meta)) = &sidecar
         && let Some(raw) = tables::raw_format(meta)
     {
+        // Read by the sidecar's shape; its provenance only if its values
+        // are these.
         return tables::read_raw(reader, len, raw, meta)
-            .map(|sets| (sets, Some(meta.clone())))
+            .map(|sets| {
+                let meta = tables::describes(meta, &sets).then(|| meta.clone());
+                (sets, meta)
+            })
             .map_err(table);
     }
     let head = reader.fill_buf().map_err(io)?;

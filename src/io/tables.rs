@@ -73,6 +73,12 @@ pub struct TableMetadata {
     pub sets: usize,
     /// Layout and value type.
     pub layout: String,
+    /// A digest of the values the table stores ([`values_digest`]), so a
+    /// sidecar left beside a file that was overwritten since (same shape,
+    /// other points) is not taken as its provenance; absent in tables
+    /// written before it existed, which are matched by shape alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub values_digest: Option<String>,
     /// The domain and estimator the sets were designed for: `torus` (the
     /// shift-randomized estimator), `square` (the unshifted estimator on
     /// [0,1)²), `none` (a classic sampler), or `unknown` (a converted file).
@@ -471,7 +477,7 @@ pub fn read_json_table(
         return Err("its `sets` is empty".into());
     };
     if let Some(meta) = &table.metadata
-        && !describes(meta, &sets)
+        && !has_shape_of(meta, &sets)
     {
         return Err(format!(
             "it holds {} sets of {} points in {}D, its metadata says {} of {} in {}D",
@@ -483,15 +489,46 @@ pub fn read_json_table(
             meta.dim
         ));
     }
-    Ok((sets, table.metadata))
+    // Values edited since the metadata was written: no provenance.
+    let metadata = table.metadata.filter(|meta| describes(meta, &sets));
+    Ok((sets, metadata))
 }
 
 /// Whether `meta` has the shape of `sets` (its N, d and count).
-pub fn describes(meta: &TableMetadata, sets: &[PointSet]) -> bool {
+fn has_shape_of(meta: &TableMetadata, sets: &[PointSet]) -> bool {
     sets.len() == meta.sets
         && sets
             .iter()
             .all(|s| s.len() == meta.n && s.dim() == meta.dim)
+}
+
+/// Whether `meta` describes `sets`: their shape, and their values when it
+/// records a [`values_digest`].
+pub fn describes(meta: &TableMetadata, sets: &[PointSet]) -> bool {
+    has_shape_of(meta, sets)
+        && meta
+            .values_digest
+            .as_ref()
+            .is_none_or(|d| *d == values_digest(sets))
+}
+
+/// The digest of a table's values: FNV-1a (64-bit) over the bytes of each
+/// value's IEEE-754 binary64 bit pattern, little-endian, in
+/// [set][point][dimension] order (an f32 table's values widened to
+/// binary64 exactly), written `fnv1a64:` and 16 hex digits. It tells a
+/// table's own metadata from a stale one; it is not a cryptographic hash.
+pub fn values_digest(sets: &[PointSet]) -> String {
+    const OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+    const PRIME: u64 = 0x0000_0100_0000_01b3;
+    let mut h = OFFSET;
+    for byte in sets
+        .iter()
+        .flat_map(|s| s.coords())
+        .flat_map(|x| x.to_bits().to_le_bytes())
+    {
+        h = (h ^ u64::from(byte)).wrapping_mul(PRIME);
+    }
+    format!("fnv1a64:{h:016x}")
 }
 
 /// The top level of a JSON table.
