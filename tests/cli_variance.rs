@@ -671,6 +671,27 @@ fn converge_on_a_square_family_matches_predict_and_the_jitter_rate() {
         "slope CI [{lo}, {hi}] misses -1.5 or is wider than 0.8: {conv}"
     );
     assert!(conv["method"].as_str().unwrap().starts_with("square"));
+    // The JSON says what the MSE was drawn over, so it reproduces (it had
+    // neither key: new-user trial); on the torus both are null.
+    assert_eq!(
+        (&conv["members"], &conv["member_seed"]),
+        (&512.into(), &4.into()),
+        "{conv}"
+    );
+    let torus = json(&[
+        "converge",
+        "--sampler",
+        "jitter",
+        "--integrand",
+        "disk",
+        "-n",
+        "64,256",
+        "--json",
+    ]);
+    assert!(
+        torus["members"].is_null() && torus["member_seed"].is_null(),
+        "{torus}"
+    );
 }
 
 /// Where the theory's rate falls outside the fitted interval, the text says

@@ -482,12 +482,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             });
         }
         let plot = LinePlot {
-            title: match &a.dims {
-                Some(d) => format!("{label} (dims {d}) on {name}"),
-                None => format!("{label} on {name}"),
+            title: match (&a.dims, &subject) {
+                (Some(d), _) => format!("{label} (dims {d}) on {name}"),
+                (None, Subject::Square(_)) => format!("{label} on {name}, unit square, no shift"),
+                (None, Subject::Torus(_)) => format!("{label} on {name}"),
             },
             x_label: "N".into(),
-            y_label: "variance".into(),
+            y_label: match subject {
+                Subject::Square(_) => "MSE (unit square, no shift)".into(),
+                Subject::Torus(_) => "variance".into(),
+            },
             log_log: true,
             series,
         };
@@ -515,6 +519,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "points": points.iter().map(|p| json!({"n": p.n, "requested": p.requested, "variance": p.variance, "stderr": p.stderr, "truncation_bound": p.truncation_bound, "seed": p.seed})).collect::<Vec<_>>(),
             "slope": fit.slope, "slope_ci": fit.slope_ci.map(|(l, h)| vec![l, h]),
             "theory": theory, "adjusted_n": adjusted,
+            // What the family's MSE was drawn over: its members and their
+            // seed (with --points the seed draws nothing else).
+            "members": matches!(subject, Subject::Square(_)).then_some(members),
+            "member_seed": matches!(subject, Subject::Square(_)).then(|| a.draw.seed()),
         });
         outln!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
@@ -526,10 +534,15 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // shown beside it, and named when it rivals the value.
     let bounded = points.iter().any(|p| p.truncation_bound > 0.0);
     let bound_header = if bounded { "  truncation_bound" } else { "" };
+    // The square's value is the unshifted estimator's MSE, not a variance.
+    let value_header = match subject {
+        Subject::Square(_) => "MSE",
+        Subject::Torus(_) => "variance",
+    };
     outln!(
         "{:>8} {:>14} {:>12}{bound_header}",
         "N",
-        "variance",
+        value_header,
         "stderr"
     );
     for p in &points {
@@ -569,6 +582,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let theory = theory.map_or(
         if plane.is_some() {
             "none (the table of known rates is of whole sets, not projections)".into()
+        } else if !a.points.is_empty() {
+            "none (files name no sampler, and the table of known rates is of samplers)".into()
         } else {
             "none (the table of known rates has no entry for this sampler and integrand)".into()
         },
