@@ -668,6 +668,8 @@ fn compare_writes_a_table_and_pictures() {
         "100",
         "--sets",
         "2",
+        "--seed",
+        "11",
         "-o",
         dir.to_str().unwrap(),
     ]);
@@ -680,6 +682,11 @@ fn compare_writes_a_table_and_pictures() {
     assert!(table.contains("poisson-disk") && table.contains("sobol") && table.contains("lattice"));
     let summary = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
     assert_eq!(summary.lines().count(), 12, "a header and 11 samplers");
+    // The seed is recorded, so the pictures can be redrawn (trial).
+    assert!(
+        summary.starts_with("sampler,n,sets,seed,") && summary.contains(",2,11,"),
+        "{summary}"
+    );
     assert!(dir.join("cmj.png").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
