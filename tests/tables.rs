@@ -825,21 +825,22 @@ fn a_table_converted_from_a_table_keeps_its_provenance() {
     assert!(last.layout.contains("f64 (double)"), "{}", last.layout);
     // A CSV whose sidecar no longer describes it (a set removed by hand)
     // is converted as a plain point file: no seed is claimed.
-    varspec(&[
-        "tables",
-        "--sampler",
-        "cmj",
-        "-n",
-        "4",
-        "--sets",
-        "2",
-        "--seed",
-        "3",
-        "--format",
-        "csv",
-        "-o",
-        &t("c.csv"),
-    ]);
+    let cmj_csv = || {
+        varspec(&[
+            "tables",
+            "--sampler",
+            "cmj",
+            "-n",
+            "4",
+            "--sets",
+            "2",
+            "--seed",
+            "3",
+            "-o",
+            &t("c.csv"),
+        ])
+    };
+    cmj_csv();
     let csv = std::fs::read_to_string(t("c.csv")).unwrap();
     let one_set: String = csv
         .lines()
@@ -862,19 +863,7 @@ fn a_table_converted_from_a_table_keeps_its_provenance() {
     // Nor is a sidecar of the same shape left beside points written over
     // its table (they were labelled `cmj (seed 3)`: new-user trial); the
     // values' digest tells them apart, and a note says so.
-    varspec(&[
-        "tables",
-        "--sampler",
-        "cmj",
-        "-n",
-        "4",
-        "--sets",
-        "2",
-        "--seed",
-        "3",
-        "-o",
-        &t("c.csv"),
-    ]);
+    cmj_csv();
     varspec(&[
         "sample",
         "random",
