@@ -730,6 +730,10 @@ fn the_main_job_writes_a_self_contained_report() {
             "63",
             "--sets",
             "4",
+            // Not the default, so the printed commands must carry it (the
+            // scene's and a spectrum's did not: second trial).
+            "--seed",
+            "5",
             "-o",
             dir.to_str().unwrap(),
         ])
@@ -811,7 +815,9 @@ fn the_main_job_writes_a_self_contained_report() {
             .map(|a| a.trim_matches('\'').to_string())
             .collect();
         for i in 0..args.len() {
-            let file = args[i].ends_with(".csv") || args[i].ends_with(".json");
+            let file = [".csv", ".json", ".png"]
+                .iter()
+                .any(|ext| args[i].ends_with(ext));
             if file || (i > 0 && args[i - 1] == "--png-prefix") {
                 args[i] = dir.join(&args[i]).to_str().unwrap().to_string();
             }
@@ -863,7 +869,7 @@ fn the_main_job_writes_a_self_contained_report() {
     // Section 5's commands write the two spectra its 1e-6 row compares
     // (it printed `bench spectrum`, which measures other sets: third
     // trial).
-    let prefix = "varspec spectrum --sampler jitter -n 1024 --sets 8 --seed 0 --res 129";
+    let prefix = "varspec spectrum --sampler jitter -n 1024 --sets 8 --seed 5 --res 129";
     run_printed("speed", &format!("{prefix} --method direct"), false);
     run_printed("speed", &format!("{prefix} --tol 1e-6"), false);
     let column = |file: &str| -> Vec<f64> {
@@ -888,6 +894,27 @@ fn the_main_job_writes_a_self_contained_report() {
     assert_eq!(row["max_error"].as_f64(), Some(max_error), "{row}");
     let scene = &report["scene"];
     assert!(scene["reduction"].as_f64().unwrap() > 1.5, "{scene}");
+    // The scene's printed render gives its unsheared row.
+    let summary = dir.join("render.json");
+    let mut render: Vec<String> = report["scene"]["commands"][0]
+        .as_str()
+        .unwrap()
+        .split_whitespace()
+        .skip(1)
+        .map(|a| match a {
+            "none.png" => dir.join(a).to_str().unwrap().to_string(),
+            _ => a.to_string(),
+        })
+        .collect();
+    render.extend(["--summary".into(), summary.to_str().unwrap().into()]);
+    render.extend(["-o".into(), dir.join("image.png").to_str().unwrap().into()]);
+    common::varspec_ok(&render.iter().map(String::as_str).collect::<Vec<_>>());
+    let rendered = common::read_json(&summary);
+    assert_eq!(
+        rendered["variance"]["mean"].as_f64(),
+        scene["rows"][0]["mean_variance"].as_f64(),
+        "the scene's printed render vs the page: {rendered}"
+    );
     assert!(
         std::fs::read_to_string(dir.join("variances.csv"))
             .unwrap()

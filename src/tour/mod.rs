@@ -525,8 +525,8 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
             2 * half + 1
         ),
         format!(
-            "varspec spectrum --sampler jitter -n {} --sets {} --res 64 --png s.png --radial r.csv",
-            n, o.sets
+            "varspec spectrum --sampler jitter -n {} --sets {} --seed {} --res 64 --png s.png --radial r.csv",
+            n, o.sets, o.seed
         ),
     ];
     Ok(PredictSection {
@@ -776,9 +776,13 @@ fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
         rows,
         pictures,
         commands: vec![
-            format!("varspec render dof --spp {spp} --renders {renders} --variance-png none.png"),
             format!(
-                "varspec render dof --spp {spp} --renders {renders} --shear analytic --variance-png warp.png --shear-png slope.png"
+                "varspec render dof --spp {spp} --renders {renders} --seed {} --variance-png none.png",
+                o.seed
+            ),
+            format!(
+                "varspec render dof --spp {spp} --renders {renders} --seed {} --shear analytic --variance-png warp.png --shear-png slope.png",
+                o.seed
             ),
         ],
     })
