@@ -8,6 +8,66 @@ fn json(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&common::varspec_ok(args).stdout).expect("one JSON object")
 }
 
+/// predict's output names the seed of what it drew (sets, shifts, members),
+/// so it reproduces from itself (it had no seed: second trial).
+#[test]
+fn predict_records_its_seed() {
+    let torus = json(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "64",
+        "--sets",
+        "2",
+        "--seed",
+        "7",
+        "--integrand",
+        "disk",
+        "--method",
+        "spatial",
+        "--json",
+    ]);
+    assert_eq!(torus["seed"], 7, "{torus}");
+    let square = json(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "64",
+        "--sets",
+        "2",
+        "--seed",
+        "7",
+        "--family",
+        "halfplanes",
+        "--members",
+        "16",
+        "--json",
+    ]);
+    assert_eq!(square["seed"], 7, "{square}");
+    let text = common::varspec_ok(&[
+        "predict",
+        "--sampler",
+        "jitter",
+        "-n",
+        "64",
+        "--sets",
+        "2",
+        "--seed",
+        "7",
+        "--integrand",
+        "disk",
+        "--method",
+        "spatial",
+    ]);
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(
+        text.lines().next().unwrap().contains("2 sets, seed 7)"),
+        "{text}"
+    );
+}
+
 #[test]
 fn predict_json_has_the_contract_keys_and_the_methods_agree() {
     let v = json(&[

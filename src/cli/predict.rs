@@ -288,6 +288,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut out = serde_json::Map::new();
     out.insert("integrand".into(), json!(f.spec()));
     out.insert("source".into(), json!(source.name()));
+    out.insert("seed".into(), json!(a.source.seed()));
     out.insert("n".into(), json!(n));
     out.insert("density".into(), json!(source.density()));
     out.insert("integral".into(), json!(f.integral()));
@@ -464,10 +465,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         None => format!("= {}", varspec::spec_params::SpecValue(f.integral())),
     };
     outln!(
-        "{} on {} ({}, {drawn_label}), I {integral}",
+        "{} on {} ({}, {drawn_label}, seed {}), I {integral}",
         f.spec(),
         source.name(),
         source.count_label(),
+        a.source.seed(),
     );
     if shift != ShiftArg::All {
         outln!("  estimator: {}", shift.estimator());
@@ -731,6 +733,7 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
     );
     out.insert("family".into(), json!(family.spec()));
     out.insert("source".into(), json!(source.name()));
+    out.insert("seed".into(), json!(seed));
     out.insert("n".into(), json!(n));
     out.insert("sets".into(), json!(sets.len()));
     out.insert(
@@ -757,7 +760,7 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
         return Ok(());
     }
     outln!(
-        "{} on {} ({}, {}), unshifted estimator on the square",
+        "{} on {} ({}, {}, seed {seed}), unshifted estimator on the square",
         family.spec(),
         source.name(),
         source.count_label(),
