@@ -154,6 +154,54 @@ fn outputs_are_written_in_every_format() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// An 8 × 8 grid's spectrum is zero off the multiples of 8: its rings 1–7
+/// are empty, so their anisotropy is 0 (formats.md), not the transform's
+/// rounding over its own square (2.7 and 5.0 by the two methods: second
+/// trial); ring 8 holds the grid's peaks among zeros, a real anisotropy.
+#[test]
+fn a_grids_empty_rings_have_no_anisotropy() {
+    for method in ["fast", "direct"] {
+        let out = varspec(&[
+            "spectrum",
+            "--sampler",
+            "regular",
+            "-n",
+            "64",
+            "--sets",
+            "2",
+            "--res",
+            "40",
+            "--method",
+            method,
+        ]);
+        ok(&out);
+        let text = String::from_utf8(out.stdout).unwrap();
+        let rings: Vec<(usize, f64, f64)> = text
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let f: Vec<&str> = l.split(',').collect();
+                (
+                    f[0].parse().unwrap(),
+                    f[1].parse().unwrap(),
+                    f[2].parse().unwrap(),
+                )
+            })
+            .collect();
+        for &(k, power, anisotropy) in &rings[..7] {
+            assert!(
+                k <= 7 && power < 1e-12 && anisotropy == 0.0,
+                "{method}: ring {k} power {power:e} anisotropy {anisotropy}"
+            );
+        }
+        let (k, _, anisotropy) = rings[7];
+        assert!(
+            k == 8 && anisotropy > 1.0,
+            "{method}: ring {k}: {anisotropy}"
+        );
+    }
+}
+
 #[test]
 fn bad_spectrum_requests_are_clear_errors() {
     let dir = temp_dir("bad");

@@ -127,13 +127,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let axes = [kx.as_str(), ky.as_str()];
     // A projection's title names its plane (XU for dims 0,2; X4X5).
     let plane_name = plane.map_or(String::new(), |_| format!(", {x}{y} plane"));
-    let (spectrum, title, bar_label) = match &a.integrand {
+    // The floor: the power an exact zero can show after the method's error
+    // (0 for an integrand's closed-form power).
+    let (spectrum, title, bar_label, floor) = match &a.integrand {
         Some(spec) => {
             let (power, name) = integrand_power(spec, plane, freqs.half, a.source.seed())?;
             (
                 power,
                 format!("{name}{plane_name}, P_f"),
                 "log10 |F_f(k)|^2",
+                0.0,
             )
         }
         None => {
@@ -168,10 +171,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 source.name(),
                 super::stdout::counted(spectrum.sets, "set")
             );
-            (spectrum, title, "log10 power (N·P_S)")
+            let n = spectrum.power[freqs.zero_index()];
+            (
+                spectrum,
+                title,
+                "log10 power (N·P_S)",
+                method.power_floor(n),
+            )
         }
     };
-    let profile = radial_profile(&spectrum);
+    let profile = radial_profile(&spectrum, floor);
     #[derive(serde::Serialize)]
     struct RadialRow {
         k: usize,

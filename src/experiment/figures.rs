@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::planes::{box_power, plane, plane_pngs};
+use super::planes::{METHOD, box_power, plane, plane_pngs};
 use super::scene_figures::{
     MAX_RENDERS, MAX_SPP, POLICIES, REFERENCE_SAMPLER, lens_design_png, pixel_files, scene_pixels,
     scene_samplers, scene_variance,
@@ -672,7 +672,7 @@ impl FigureExperiment {
                     used.push(format!("{name} ({})", size_used(*n, m)));
                     series.push(Series {
                         label: name.clone(),
-                        points: radial_profile(&s)
+                        points: radial_profile(&s, METHOD.power_floor(m as f64))
                             .iter()
                             .map(|b| (b.k as f64, b.power))
                             .collect(),

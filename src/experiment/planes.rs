@@ -13,6 +13,11 @@ use crate::variance::VarianceError;
 /// The NUFFT tolerance of the figures' spectra.
 const TOLERANCE: f64 = 1e-9;
 
+/// The transform every figure's spectrum uses.
+pub(super) const METHOD: Method = Method::Fast {
+    tolerance: TOLERANCE,
+};
+
 /// A projection plane of a 4D set: its coordinates and frequency axes.
 pub(super) fn plane(name: &str) -> Result<([usize; 2], [&'static str; 2]), String> {
     match name {
@@ -33,9 +38,7 @@ pub(super) fn box_power(
 ) -> Result<Spectrum, VarianceError> {
     expected_power(
         FrequencyBox::from_resolution(2, res),
-        Method::Fast {
-            tolerance: TOLERANCE,
-        },
+        METHOD,
         sets,
         realization,
         &|| {},

@@ -15,7 +15,10 @@ pub struct RadialBin {
     /// Mean power over the ring.
     pub power: f64,
     /// Sample variance of the power over the ring / mean²; 0 on a ring of
-    /// zero power (powers are ≥ 0, so a zero mean is a constant ring).
+    /// zero power (powers are ≥ 0, so a zero mean is a constant ring), and
+    /// on one whose mean power is at or below the spectrum's floor (its
+    /// powers are the transform's error, whose spread over its own mean is
+    /// noise, not anisotropy).
     pub anisotropy: f64,
     /// Frequencies in the ring.
     pub count: usize,
@@ -75,8 +78,11 @@ pub fn ring_moments(ring: &[usize], values: &[f64]) -> Vec<RingMoments> {
 }
 
 /// The radial profile of a spectrum for rings 1..=h (only rings that lie
-/// wholly in the box) with at least two frequencies.
-pub fn radial_profile(spectrum: &Spectrum) -> Vec<RadialBin> {
+/// wholly in the box) with at least two frequencies. `floor` is the power
+/// an exact zero can show after the method's error
+/// ([`Method::power_floor`](super::Method::power_floor); 0 for a closed
+/// form): rings at or below it have anisotropy 0.
+pub fn radial_profile(spectrum: &Spectrum, floor: f64) -> Vec<RadialBin> {
     let h = spectrum.freqs.half;
     ring_moments(&rings_of(&spectrum.freqs), &spectrum.power)
         .into_iter()
@@ -84,7 +90,7 @@ pub fn radial_profile(spectrum: &Spectrum) -> Vec<RadialBin> {
         .filter(|&(r, m)| (1..=h).contains(&r) && m.count > 1)
         .map(|(r, m)| {
             let var = m.centred_squares / (m.count - 1) as f64;
-            let anisotropy = if m.mean > 0.0 {
+            let anisotropy = if m.mean > floor {
                 var / (m.mean * m.mean)
             } else {
                 0.0

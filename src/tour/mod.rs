@@ -455,14 +455,16 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
             file,
             caption: format!("{name}, N = {n}"),
         });
+        let method = Method::Fast { tolerance: 1e-9 };
         let spectrum = expected_power(
             freqs,
-            Method::Fast { tolerance: 1e-9 },
+            method,
             sets.len(),
             |r| Ok::<_, crate::spectrum::SpectrumError>(sets[r].clone()),
             &|| {},
         )
         .map_err(at("spectrum"))?;
+        let floor = method.power_floor(n as f64);
         if matches!(name, "jitter" | "cmj" | "blue-noise") {
             let file = format!("spectrum-{name}.png");
             spectrum_png(&spectrum, &format!("{name} N={n}"), &o.folder.join(&file))
@@ -474,7 +476,7 @@ fn predict_section(o: &TourOptions) -> Result<PredictSection, TourError> {
         }
         profiles.push(Series {
             label: name.into(),
-            points: radial_profile(&spectrum)
+            points: radial_profile(&spectrum, floor)
                 .iter()
                 .filter(|b| b.k > 0)
                 .map(|b| (b.k as f64, b.power))

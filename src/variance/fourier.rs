@@ -43,7 +43,7 @@
 //! Rounding: a set that integrates f exactly (uniform jitter on a smooth
 //! bump) has a Fourier variance of zero, and the computed one is what the
 //! arithmetic leaves. Two sources bound it. The transform's error is
-//! |ΔS(k)| ≤ e = 25·ε·N at tolerance ε (measured: [`NUFFT_ERROR_FACTOR`]), so
+//! |ΔS(k)| ≤ e = 25·ε·N at tolerance ε (measured: [`NUFFT_ERROR_FACTOR`](crate::spectrum::expected::NUFFT_ERROR_FACTOR)), so
 //! N·P_S = |S|²/N is off by at most (2|S|·e + e²)/N per frequency, with
 //! E|S| ≤ √(E|S|²) (Jensen) from the expected power; weighted by P_f and
 //! summed over the box. The tail T = c_f(0) − Σ_(k∈B) P_f is a difference
@@ -153,15 +153,6 @@ pub struct FourierParts {
     /// The normalisation: N, or the density λ of a random-count process.
     pub intensity: f64,
 }
-
-/// The transform's error per frequency as a multiple of ε·N, measured
-/// (not proved) on single points, where no averaging between points helps:
-/// up to 7.6·ε·N for ε = 1e-3 … 1e-10 on boxes to 513² (6.6 at 1e-6 for a
-/// point at the centre), up to 14 at 1e-12 and 23 at ε = 1e-10 … 1e-14 on
-/// a 4001² box (the kernels' per-axis errors add, and the transform's own
-/// rounding grows with the grid); sets of 200 random points stay within
-/// 1.4·ε·N. The rounding bound takes the worst with some room.
-const NUFFT_ERROR_FACTOR: f64 = 25.0;
 
 /// As [`fourier`], keeping the spectra.
 ///
@@ -424,7 +415,7 @@ fn assemble(
     });
     let rounding_bound = {
         let largest = counts.iter().copied().max().unwrap_or(0) as f64;
-        let e = NUFFT_ERROR_FACTOR * tolerance * largest;
+        let e = crate::spectrum::expected::NUFFT_ERROR_FACTOR * tolerance * largest;
         // Σ (2|S|·e + e²)/N·P_f with |S| = √(N·P_S): the two sums the box
         // pass gathered.
         let transform = (2.0 * e * root_weighted.value() * nf.sqrt() + e * e * mass.value()) / nf;
