@@ -546,6 +546,13 @@ fn optimize_commands_write_sets_and_reports() {
     assert_eq!((sets.len(), sets[0].len()), (2, 64));
     let r = common::read_json(&report);
     assert!(r["loss_curve"].as_array().unwrap().len() > 10 && r["seconds"].as_f64().unwrap() > 0.0);
+    // What bounds the run is in the report, so a stop can be re-run (the
+    // torus report had neither: second trial); blue noise's default rule.
+    assert_eq!(
+        (&r["max_iterations"], &r["rel_tol"]),
+        (&100.into(), &1e-3.into()),
+        "{r}"
+    );
     for name in ["optimized", "jitter", "cmj", "sobol", "poisson-disk"] {
         assert!(
             r["comparison"][name]["loss"].as_f64().unwrap() > 0.0,

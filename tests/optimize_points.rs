@@ -175,9 +175,19 @@ fn the_descent_reports_why_it_stopped() {
     let converged = run(100_000, 1e-6, 0.0);
     assert_eq!(converged.stop, Stop::Converged);
     assert!(converged.losses.len() < 100_000 && converged.best_score < 1.0 + 1e-3);
+    // 20 steps: the start's loss and each step's (the last step's set was
+    // never evaluated, so --iters 1 returned the start: second trial).
     let capped = run(20, 1e-6, 0.0);
     assert_eq!(capped.stop, Stop::Cap);
-    assert_eq!(capped.losses.len(), 20);
+    assert_eq!(capped.losses.len(), 21);
+    let one = run(1, 0.0, 0.0);
+    assert_eq!(one.losses.len(), 2);
+    assert!(
+        one.best_score < one.start_score,
+        "one step down the bowl: {} from {}",
+        one.best_score,
+        one.start_score
+    );
     let floored = run(100_000, 0.0, 1.2);
     assert_eq!(floored.stop, Stop::Floor);
     assert!(floored.best_score <= 1.2 && floored.losses.len() > 1);

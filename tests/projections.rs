@@ -167,7 +167,8 @@ fn the_projection_report_counts_each_sets_iterations() {
         dir.join("c.png").to_str().unwrap(),
     ]);
     let r = crate::common::read_json(&report);
-    assert_eq!(r["iterations"], serde_json::json!([7, 7]), "{r}");
+    // 7 steps: 8 losses, the start's included.
+    assert_eq!(r["iterations"], serde_json::json!([8, 8]), "{r}");
     assert_eq!(r["max_iterations"], 7);
     // The loss curve options are honoured here too (they were ignored by
     // 4D projection designs): the CSV holds set 0's curve of the report.

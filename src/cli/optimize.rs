@@ -410,18 +410,19 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
             eprintln!("warning: checkpoint {} not removed: {e}", file.display());
         }
     }
+    // Steps taken: a loss curve holds the start's loss and each step's.
     let coarse = match (design.coarse_iterations[0], plan.coarse_half()) {
-        (c, Some(h)) if c > 0 => format!("{c} on the box |k| <= {h} then "),
+        (c, Some(h)) if c > 0 => format!("{} on the box |k| <= {h} then ", c - 1),
         _ => String::new(),
     };
+    let steps = design.iterations[0].saturating_sub(1);
     outln!(
-        "{} set(s) of {} points for {} in {:.2} s ({coarse}{} iteration{} for set 0, {}); loss {:.4e}; compared with the classic samplers in {:.2} s",
+        "{} set(s) of {} points for {} in {:.2} s ({coarse}{steps} step{} for set 0, {}); loss {:.4e}; compared with the classic samplers in {:.2} s",
         a.sets,
         a.n,
         a.target,
         design.run.seconds,
-        design.iterations[0],
-        if design.iterations[0] == 1 { "" } else { "s" },
+        if steps == 1 { "" } else { "s" },
         design.stopped[0].describe(),
         design.mean_loss,
         design.comparison_seconds

@@ -76,6 +76,9 @@ pub struct ProjectionDesign {
     pub iterations: Vec<usize>,
     /// The iteration cap (`--iters`).
     pub max_iterations: usize,
+    /// The stopping rule's relative improvement over 50 iterations
+    /// (`--rel-tol`; 0: never stop early).
+    pub rel_tol: f64,
     /// Why each set's descent stopped (converged, accuracy floor or cap).
     pub stopped: Vec<Stop>,
     /// Per term, before and after.
@@ -164,6 +167,7 @@ pub fn design_projections(
         },
         iterations: results.iter().map(|x| x.1.losses.len()).collect(),
         max_iterations: options.iters,
+        rel_tol: options.rel_tol,
         stopped: results.iter().map(|x| x.1.stop).collect(),
         terms: terms_out,
         closest_pair_over_hexagonal: closest_pairs,

@@ -92,8 +92,14 @@ pub struct TorusDesign {
     pub tolerance: f64,
     /// NUFFT upsampling factor.
     pub upsampling: f64,
-    /// Iterations run per set.
+    /// Per set: entries of its loss curve (the start's loss and each
+    /// step's).
     pub iterations: Vec<usize>,
+    /// The iteration cap (`--iters`).
+    pub max_iterations: usize,
+    /// The stopping rule's relative improvement over 50 iterations
+    /// (`--rel-tol`; 0: never stop early).
+    pub rel_tol: f64,
     /// Iterations on the coarse box per set.
     pub coarse_iterations: Vec<usize>,
     /// Why each set's descent stopped (converged, accuracy floor or cap).
@@ -408,6 +414,8 @@ impl TorusPlan {
             tolerance: self.tolerance,
             upsampling: self.optimizer.upsampling(),
             iterations: results.iter().map(|k| k.descent.losses.len()).collect(),
+            max_iterations: self.iters,
+            rel_tol: self.rel_tol,
             coarse_iterations: results.iter().map(|k| k.descent.coarse_iterations).collect(),
             stopped: results.iter().map(|k| k.descent.stop).collect(),
             loss: "sum over 0 < |k|inf <= half of W(k) P_S(k)  (for an integrand target: its predicted variance within the box)",

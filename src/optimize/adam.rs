@@ -12,7 +12,8 @@
 //! Adam, not large ones) and halves the rate. The descent stops when the
 //! score improves by less than a relative `rel_tol` over 50 scored
 //! iterations (0 disables the test), once it reaches the objective's
-//! accuracy floor, or after `iters`.
+//! accuracy floor, or after `iters` steps (whose curve holds `iters` + 1
+//! losses: the start's and every step's).
 
 use crate::points::{PointSet, wrap01};
 use crate::rng::PREV_ONE;
@@ -315,10 +316,22 @@ pub fn adam_from(
             *x = domain.confine(*x - step);
         }
     }
-    // A stochastic objective's last iterate is scored too.
-    if o.score_every > 1 {
+    // Run to the cap, the last step's set has not been evaluated: its loss
+    // ends the curve and it competes for the best, so `iters` steps are
+    // all taken (`--iters 1` returned the start unchanged).
+    if stop == Stop::Cap && o.iters > 0 {
+        let t = s.t;
         let points = PointSet::new(d, s.x.clone()).expect("confined coordinates lie in [0,1)");
-        if let Some(score) = objective.score(&points)
+        let loss = objective.loss_and_gradient(&points, t, &mut grad);
+        s.losses.push(loss);
+        s.seconds.push(offset + clock.elapsed().as_secs_f64());
+        on_iteration(t, loss);
+        let score = if o.score_every <= 1 {
+            Some(loss)
+        } else {
+            objective.score(&points)
+        };
+        if let Some(score) = score
             && score < s.best_score
         {
             s.best_score = score;
