@@ -256,6 +256,27 @@ fn listed_family_design_fits_its_members() {
         ours < 0.2 * cmj,
         "listed family: designed {ours:e} against CMJ's {cmj:e}"
     );
+    // The command says that score is not held out (it printed it beside
+    // held-out ones, "scored on 1024 members per family": second trial).
+    let out = crate::common::varspec_ok(&[
+        "optimize",
+        "points",
+        "--domain",
+        "square",
+        "-n",
+        "16",
+        "--sets",
+        "1",
+        "--iters",
+        "3",
+        "--target",
+        &spec,
+        "-o",
+        "/dev/null",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("none held out"), "{err}");
+    std::fs::remove_file(&list).unwrap();
 }
 
 #[test]

@@ -613,6 +613,20 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
             other_n(v, a.n)
         );
     }
+    // A listed family has no other members to hold out.
+    let listed: Vec<&str> = design
+        .families
+        .iter()
+        .map(String::as_str)
+        .filter(|f| f.starts_with("file:"))
+        .collect();
+    if !listed.is_empty() {
+        eprintln!(
+            "note: {} scored on the members the descent fitted (a listed family's members are \
+             its list, none held out), so its score is not a held-out one",
+            listed.join(", ")
+        );
+    }
     design_outputs(
         &a,
         &format!("{} N={} on the square", a.target, a.n),

@@ -237,8 +237,19 @@ impl Family {
     }
 }
 
+/// The largest family file read: 16 MiB, some 300,000 specs (a device
+/// such as /dev/zero was read until memory ran out).
+const FAMILY_FILE_LIMIT: u64 = 16 << 20;
+
+/// A `file:PATH` family: one 2D catalogue spec per line, `#` comments and
+/// blank lines skipped (docs/formats.md, "Family file").
 fn read_list(path: &str) -> Result<Family, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
+    let text = crate::io::read_text_bounded(
+        std::path::Path::new(path),
+        FAMILY_FILE_LIMIT,
+        "a family file",
+    )
+    .map_err(|e| format!("{path}: {e}"))?;
     let mut specs = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
