@@ -640,3 +640,37 @@ fn the_written_sets_are_the_seeded_sets_sheared_by_the_found_shear() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The objective's description says, per half, whether it is a closed
+/// form or estimated (it was one sentence for every sampler: second
+/// trial).
+#[test]
+fn the_objective_says_which_half_is_estimated() {
+    for (sampler, said) in [
+        (
+            "umj",
+            "(x, y) half in closed form, (u, v) half in closed form",
+        ),
+        (
+            "padded:xy=cmj,uv=poisson-disk",
+            "(x, y) half in closed form, (u, v) half estimated from",
+        ),
+    ] {
+        let out = crate::common::varspec_ok(&[
+            "optimize",
+            "shear",
+            "--sampler",
+            sampler,
+            "-n",
+            "16",
+            "--integrand",
+            "defocus:c=0.5",
+            "--realizations",
+            "0",
+            "--json",
+        ]);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let description = v["objective"]["description"].as_str().unwrap();
+        assert!(description.contains(said), "{sampler}: {description}");
+    }
+}

@@ -252,7 +252,7 @@ pub fn search_and_check(
         "spectrum": {"xu": plane(&spectral.planes[0]), "yv": plane(&spectral.planes[1])},
         "estimator": "(x,y)-shifted: mean of f(x'+sx, y'+sy, u, v) over the sheared set, s uniform in (x,y); unbiased for any shear",
         "objective": {
-            "description": "expected variance of the estimator over the sampler's randomness (closed form where the halves have one)",
+            "description": objective_description(objective.realizations()),
             "unsheared": found.unsheared.value, "initial": found.initial.1, "optimum": found.optimum.value,
             "stderr": (found.optimum.value > 0.0).then(|| found.optimum.stderr / found.optimum.value),
             "unsheared_stderr": (found.unsheared.value > 0.0).then(|| found.unsheared.stderr / found.unsheared.value),
@@ -281,6 +281,21 @@ pub fn search_and_check(
         warnings,
         report,
     })
+}
+
+/// The objective in words, per half: closed form, or estimated from how
+/// many realizations (`realizations` as [`ShearObjective::realizations`]:
+/// 0 for a closed form).
+fn objective_description([xy, uv]: [usize; 2]) -> String {
+    let half = |name: &str, sets: usize| match sets {
+        0 => format!("{name} half in closed form"),
+        r => format!("{name} half estimated from {r} realizations"),
+    };
+    format!(
+        "expected variance of the estimator over the sampler's randomness: {}, {}",
+        half("(x, y)", xy),
+        half("(u, v)", uv)
+    )
 }
 
 #[cfg(test)]
