@@ -200,7 +200,7 @@ fn variances_zero_to_rounding_are_reported_as_such_and_not_fitted() {
         csv.lines()
             .next()
             .unwrap()
-            .ends_with(",sets,seed,rounding_bound")
+            .ends_with(",sets,seed,rounding_bound,truncation_bound")
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -38,6 +38,7 @@ pub fn write_results(
                 e.sets.to_string(),
                 crate::rng::level_seed(e.seed, c.n).to_string(),
                 format!("{:e}", c.rounding_bound),
+                format!("{:e}", c.truncation_bound),
             ]
         })
         .collect();
@@ -54,6 +55,7 @@ pub fn write_results(
             "sets",
             "seed",
             "rounding_bound",
+            "truncation_bound",
         ],
         &rows,
         &fail,

@@ -38,6 +38,9 @@ pub struct Cell {
     /// or below a positive bound is zero to rounding. Required in shard files: shards written before it (and
     /// before each N drew its own seed) are refused, not merged.
     pub rounding_bound: f64,
+    /// The Fourier form's bound on what its box leaves out (0 for the
+    /// spatial form). Required in shard files, as `rounding_bound`.
+    pub truncation_bound: f64,
     /// `spatial` or `fourier`.
     pub method: String,
     /// The radial predictor on the same realizations, when the experiment
@@ -224,6 +227,7 @@ pub fn run_items(
                     variance: p.variance,
                     stderr: (e.sets >= 2).then_some(p.stderr),
                     rounding_bound: p.rounding_bound,
+                    truncation_bound: p.truncation_bound,
                     method: p.method.to_string(),
                     radial,
                 });
