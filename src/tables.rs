@@ -177,24 +177,25 @@ pub fn metadata(
     };
     // A single-precision table is predicted on the values it stores.
     let single = matches!(format, TableFormat::F32 | TableFormat::CHeader);
-    let stored: Option<Vec<PointSet>> = single.then(|| {
-        sets.iter()
-            .map(|s| {
-                let coords = s
-                    .coords()
-                    .iter()
-                    .map(|&x| f64::from(to_unit_f32(x)))
-                    .collect();
-                let stored =
-                    PointSet::new(dim, coords).expect("f32 values of [0, 1) points lie in [0, 1)");
-                match s.density() {
-                    Some(density) => stored.with_density(density),
-                    None => Ok(stored),
-                }
-            })
-            .collect::<Result<_, _>>()
-            .expect("the density was valid on the f64 set")
-    });
+    let stored: Option<Vec<PointSet>> =
+        (single && status == PredictedVariances::Computed).then(|| {
+            sets.iter()
+                .map(|s| {
+                    let coords = s
+                        .coords()
+                        .iter()
+                        .map(|&x| f64::from(to_unit_f32(x)))
+                        .collect();
+                    let stored = PointSet::new(dim, coords)
+                        .expect("f32 values of [0, 1) points lie in [0, 1)");
+                    match s.density() {
+                        Some(density) => stored.with_density(density),
+                        None => Ok(stored),
+                    }
+                })
+                .collect::<Result<_, _>>()
+                .expect("the density was valid on the f64 set")
+        });
     let sets = stored.as_deref().unwrap_or(sets);
     let predicted_variance = if status == PredictedVariances::Computed {
         REFERENCE_INTEGRANDS
@@ -233,7 +234,11 @@ pub fn metadata(
         dim,
         sets: sets.len(),
         layout: format!("[set][point][dimension], {value_type}, values in [0, 1)"),
-        values_digest: Some(values_digest(sets)),
+        values_digest: Some(values_digest(sets.iter().flat_map(|s| s.coords()).map(
+            |&x| {
+                if single { f64::from(to_unit_f32(x)) } else { x }
+            },
+        ))),
         optimized_for: provenance.optimized_for,
         dimensions: provenance.dimensions,
         predicted_variance,

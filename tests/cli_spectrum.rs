@@ -160,8 +160,12 @@ fn outputs_are_written_in_every_format() {
 /// trial); ring 8 holds the grid's peaks among zeros, a real anisotropy.
 #[test]
 fn a_grids_empty_rings_have_no_anisotropy() {
-    for method in ["fast", "direct"] {
-        let out = varspec(&[
+    // At a coarse tolerance the empty rings read the transform's error, yet
+    // ring 8's peaks are kept: a ring is empty only if every power is
+    // within what 0 reads (a rule on its mean hid ring 8 at --tol 3e-2:
+    // review).
+    for (method, tol) in [("fast", "1e-9"), ("direct", ""), ("fast", "3e-2")] {
+        let mut args = vec![
             "spectrum",
             "--sampler",
             "regular",
@@ -173,8 +177,17 @@ fn a_grids_empty_rings_have_no_anisotropy() {
             "40",
             "--method",
             method,
-        ]);
+        ];
+        if !tol.is_empty() {
+            args.extend(["--tol", tol]);
+        }
+        let out = varspec(&args);
         ok(&out);
+        let note = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            note.contains("hold only powers within"),
+            "{method} {tol}: {note}"
+        );
         let text = String::from_utf8(out.stdout).unwrap();
         let rings: Vec<(usize, f64, f64)> = text
             .lines()
@@ -190,8 +203,8 @@ fn a_grids_empty_rings_have_no_anisotropy() {
             .collect();
         for &(k, power, anisotropy) in &rings[..7] {
             assert!(
-                k <= 7 && power < 1e-12 && anisotropy == 0.0,
-                "{method}: ring {k} power {power:e} anisotropy {anisotropy}"
+                k <= 7 && (tol == "3e-2" || power < 1e-12) && anisotropy == 0.0,
+                "{method} {tol}: ring {k} power {power:e} anisotropy {anisotropy}"
             );
         }
         let (k, _, anisotropy) = rings[7];

@@ -755,6 +755,25 @@ fn converge_on_a_square_family_matches_predict_and_the_jitter_rate() {
         "64,256",
         "--json",
     ]);
+    // A listed family's members are its list, whatever --members says
+    // (it reported 1024 for a two-line file: review).
+    let dir = common::temp_dir("converge-listed");
+    let list = dir.join("fam.txt");
+    std::fs::write(&list, "disk:r=0.2\nbox:w=0.3,h=0.2\n").unwrap();
+    let listed = json(&[
+        "converge",
+        "--sampler",
+        "jitter",
+        "--family",
+        &format!("file:{}", list.display()),
+        "-n",
+        "16,64",
+        "--sets",
+        "2",
+        "--json",
+    ]);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(listed["members"], 2, "{listed}");
     assert!(
         torus["members"].is_null() && torus["member_seed"].is_null(),
         "{torus}"

@@ -521,7 +521,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             "theory": theory, "adjusted_n": adjusted,
             // What the family's MSE was drawn over: its members and their
             // seed (with --points the seed draws nothing else).
-            "members": matches!(subject, Subject::Square(_)).then_some(members),
+            "members": match &subject {
+                Subject::Square(family) => Some(family.sample_size(members)),
+                Subject::Torus(_) => None,
+            },
             "member_seed": matches!(subject, Subject::Square(_)).then(|| a.draw.seed()),
         });
         outln!("{}", serde_json::to_string_pretty(&out)?);

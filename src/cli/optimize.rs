@@ -335,7 +335,7 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
         frequencies.len(),
         rayon::current_num_threads().min(a.sets)
     );
-    let bar = progress::bar((a.sets * plan.iters()) as u64, "optimizing");
+    let bar = progress::bar((a.sets * (plan.iters() + 1)) as u64, "optimizing");
     let run = plan.run_line();
     let on_event = |event: CheckpointEvent| match event {
         CheckpointEvent::Resumed {
@@ -487,7 +487,10 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
         seed: a.seed,
         init: a.init.clone(),
     };
-    let bar = progress::bar((a.sets * a.iters.unwrap_or(1000)) as u64, "optimizing");
+    let bar = progress::bar(
+        (a.sets * (a.iters.unwrap_or(1000) + 1)) as u64,
+        "optimizing",
+    );
     let design = design_projections(&request, &|_, _| bar.inc(1))?;
     bar.finish_and_clear();
     varspec::io::write_point_file(&a.output, &design.points)?;
@@ -570,7 +573,7 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
     let iters = a
         .iters
         .unwrap_or(varspec::square::design::default_options().iters);
-    let bar = progress::bar((a.sets * iters) as u64, "optimizing");
+    let bar = progress::bar((a.sets * (iters + 1)) as u64, "optimizing");
     let design = design_on_square(&request, &|_, _| bar.inc(1))?;
     bar.finish_and_clear();
     varspec::io::write_point_file(&a.output, &design.points)?;

@@ -181,6 +181,24 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         }
     };
     let profile = radial_profile(&spectrum, floor);
+    // Rings a coarse --tol cannot tell from empty are said, not hidden.
+    let within: Vec<String> = profile
+        .iter()
+        .filter(|b| b.within_error && b.power > 0.0)
+        .map(|b| b.k.to_string())
+        .collect();
+    if !within.is_empty() && a.integrand.is_none() {
+        eprintln!(
+            "note: ring(s) {} hold only powers within what an exact 0 reads after the \
+             transform's error (<= {floor:.2e}): their anisotropy is written as 0{}",
+            within.join(", "),
+            match a.method.unwrap_or(MethodArg::Fast) {
+                MethodArg::Fast =>
+                    "; a smaller --tol (or --method direct) resolves rings that are not empty",
+                MethodArg::Direct => "",
+            }
+        );
+    }
     #[derive(serde::Serialize)]
     struct RadialRow {
         k: usize,

@@ -220,10 +220,11 @@ pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
     read_point_sets_with_metadata(path).map(|(sets, _)| sets)
 }
 
-/// As [`read_point_sets`], with the metadata of a varspec table: a JSON
-/// table's own, or a sidecar `PATH.json` that describes the sets read (the
-/// same N, d and count; a stale one is left out). `None` for other files
-/// and for C headers (whose metadata is a comment).
+/// As [`read_point_sets`], with the metadata of a varspec table that
+/// describes the sets read ([`tables::describes`]: the same N, d and count,
+/// and the values' digest where it records one; a stale one is left out):
+/// a JSON table's own, a C header's `metadata (JSON)` comment line, or a
+/// sidecar `PATH.json`. `None` for other files.
 ///
 /// # Errors
 /// As [`read_point_sets`].

@@ -360,7 +360,7 @@ pub struct HeatMap<'a> {
 }
 
 /// Writes a 2D power spectrum as a heat map centred at DC, log10 power in
-/// the viridis colour map with a labelled colour bar (760×640 PNG, square
+/// the viridis colour map with a labelled colour bar (a 760×609 PNG: square
 /// cells).
 ///
 /// The colour range spans the powers at k ≠ 0: from the largest down at

@@ -16,10 +16,14 @@ pub struct RadialBin {
     pub power: f64,
     /// Sample variance of the power over the ring / mean²; 0 on a ring of
     /// zero power (powers are ≥ 0, so a zero mean is a constant ring), and
-    /// on one whose mean power is at or below the spectrum's floor (its
-    /// powers are the transform's error, whose spread over its own mean is
-    /// noise, not anisotropy).
+    /// on one every power of which is at or below the spectrum's floor
+    /// (`within_error`).
     pub anisotropy: f64,
+    /// Every power of the ring is at or below the floor: what an exact 0
+    /// can read after the method's error, so the ring may hold nothing (a
+    /// lattice's empty rings) and its spread is the transform's error, not
+    /// anisotropy.
+    pub within_error: bool,
     /// Frequencies in the ring.
     pub count: usize,
 }
@@ -33,6 +37,8 @@ pub struct RingMoments {
     pub mean: f64,
     /// Σ (value − mean)² over the ring.
     pub centred_squares: f64,
+    /// The largest value.
+    pub max: f64,
 }
 
 /// The ring round(|k|) of every frequency of `freqs`, in box order.
@@ -55,9 +61,11 @@ pub fn ring_moments(ring: &[usize], values: &[f64]) -> Vec<RingMoments> {
     let rings = ring.iter().copied().max().map_or(0, |r| r + 1);
     let mut count = vec![0usize; rings];
     let mut sums = vec![NeumaierSum::default(); rings];
+    let mut max = vec![f64::NEG_INFINITY; rings];
     for (&r, &v) in ring.iter().zip(values) {
         count[r] += 1;
         sums[r].add(v);
+        max[r] = max[r].max(v);
     }
     let mean: Vec<f64> = sums
         .iter()
@@ -73,6 +81,7 @@ pub fn ring_moments(ring: &[usize], values: &[f64]) -> Vec<RingMoments> {
             count: count[r],
             mean: mean[r],
             centred_squares: centred[r].value(),
+            max: max[r],
         })
         .collect()
 }
@@ -81,7 +90,7 @@ pub fn ring_moments(ring: &[usize], values: &[f64]) -> Vec<RingMoments> {
 /// wholly in the box) with at least two frequencies. `floor` is the power
 /// an exact zero can show after the method's error
 /// ([`Method::power_floor`](super::Method::power_floor); 0 for a closed
-/// form): rings at or below it have anisotropy 0.
+/// form): rings whose every power is at or below it have anisotropy 0.
 pub fn radial_profile(spectrum: &Spectrum, floor: f64) -> Vec<RadialBin> {
     let h = spectrum.freqs.half;
     ring_moments(&rings_of(&spectrum.freqs), &spectrum.power)
@@ -90,7 +99,8 @@ pub fn radial_profile(spectrum: &Spectrum, floor: f64) -> Vec<RadialBin> {
         .filter(|&(r, m)| (1..=h).contains(&r) && m.count > 1)
         .map(|(r, m)| {
             let var = m.centred_squares / (m.count - 1) as f64;
-            let anisotropy = if m.mean > floor {
+            let within_error = m.max <= floor;
+            let anisotropy = if m.mean > 0.0 && !within_error {
                 var / (m.mean * m.mean)
             } else {
                 0.0
@@ -99,6 +109,7 @@ pub fn radial_profile(spectrum: &Spectrum, floor: f64) -> Vec<RadialBin> {
                 k: r,
                 power: m.mean,
                 anisotropy,
+                within_error,
                 count: m.count,
             }
         })
