@@ -12,7 +12,7 @@ fn json(args: &[&str]) -> serde_json::Value {
 /// so it reproduces from itself (it had no seed: second trial).
 #[test]
 fn predict_records_its_seed() {
-    let torus = json(&[
+    let drawn = [
         "predict",
         "--sampler",
         "jitter",
@@ -22,45 +22,20 @@ fn predict_records_its_seed() {
         "2",
         "--seed",
         "7",
-        "--integrand",
-        "disk",
-        "--method",
-        "spatial",
-        "--json",
-    ]);
+    ];
+    let with = |rest: &[&'static str]| [&drawn[..], rest].concat();
+    let disk = ["--integrand", "disk", "--method", "spatial"];
+    let torus = json(&with(&[&disk[..], &["--json"]].concat()));
     assert_eq!(torus["seed"], 7, "{torus}");
-    let square = json(&[
-        "predict",
-        "--sampler",
-        "jitter",
-        "-n",
-        "64",
-        "--sets",
-        "2",
-        "--seed",
-        "7",
+    let square = json(&with(&[
         "--family",
         "halfplanes",
         "--members",
         "16",
         "--json",
-    ]);
+    ]));
     assert_eq!(square["seed"], 7, "{square}");
-    let text = common::varspec_ok(&[
-        "predict",
-        "--sampler",
-        "jitter",
-        "-n",
-        "64",
-        "--sets",
-        "2",
-        "--seed",
-        "7",
-        "--integrand",
-        "disk",
-        "--method",
-        "spatial",
-    ]);
+    let text = common::varspec_ok(&with(&disk));
     let text = String::from_utf8(text.stdout).unwrap();
     assert!(
         text.lines().next().unwrap().contains("2 sets, seed 7)"),
