@@ -252,8 +252,13 @@ pub fn adam_from(
     let clock = std::time::Instant::now();
     let mut last_save = clock;
     let mut stop = Stop::Cap;
-    while s.t < o.iters {
+    // `iters` steps: the start and every step's set are evaluated, the
+    // last step's too (it ends the curve and competes for the best; it was
+    // never evaluated, so `--iters 1` returned the start unchanged).
+    let evaluations = if o.iters == 0 { 0 } else { o.iters + 1 };
+    while s.t < evaluations {
         let t = s.t;
+        let last = t == o.iters;
         if let Some(c) = checkpointing
             && t > 0
             && last_save.elapsed() >= c.every
@@ -270,7 +275,7 @@ pub fn adam_from(
         on_iteration(t, loss);
         let scored = if o.score_every <= 1 {
             Some(loss)
-        } else if t % o.score_every == 0 {
+        } else if last || t % o.score_every == 0 {
             Some(objective.score(&points).unwrap_or(loss))
         } else {
             None
@@ -291,6 +296,10 @@ pub fn adam_from(
                 s.since_reset = 0;
                 s.damping *= 0.5;
                 continue;
+            }
+            // No step follows the last set (it is always scored).
+            if last {
+                break;
             }
             let k = s.scores.len();
             if score <= o.floor {
@@ -314,28 +323,6 @@ pub fn adam_from(
             *v = beta2 * *v + (1.0 - beta2) * g * g;
             let step = lr * (*m / c1) / ((*v / c2).sqrt() + eps);
             *x = domain.confine(*x - step);
-        }
-    }
-    // Run to the cap, the last step's set has not been evaluated: its loss
-    // ends the curve and it competes for the best, so `iters` steps are
-    // all taken (`--iters 1` returned the start unchanged).
-    if stop == Stop::Cap && o.iters > 0 {
-        let t = s.t;
-        let points = PointSet::new(d, s.x.clone()).expect("confined coordinates lie in [0,1)");
-        let loss = objective.loss_and_gradient(&points, t, &mut grad);
-        s.losses.push(loss);
-        s.seconds.push(offset + clock.elapsed().as_secs_f64());
-        on_iteration(t, loss);
-        let score = if o.score_every <= 1 {
-            Some(loss)
-        } else {
-            objective.score(&points)
-        };
-        if let Some(score) = score
-            && score < s.best_score
-        {
-            s.best_score = score;
-            s.best_x = s.x;
         }
     }
     let points = PointSet::new(d, s.best_x).expect("confined coordinates lie in [0,1)");

@@ -33,7 +33,7 @@ pub enum Method {
 /// a 4001² box (the kernels' per-axis errors add, and the transform's own
 /// rounding grows with the grid); sets of 200 random points stay within
 /// 1.4·ε·N. The rounding bound takes the worst with some room.
-pub const NUFFT_ERROR_FACTOR: f64 = 25.0;
+const NUFFT_ERROR_FACTOR: f64 = 25.0;
 
 /// |ΔS(k)| of the direct sums as a multiple of u·N (u the unit roundoff):
 /// each term's phase is reduced exactly and its cosine and sine are within
@@ -41,17 +41,26 @@ pub const NUFFT_ERROR_FACTOR: f64 = 25.0;
 const DIRECT_ERROR_FACTOR: f64 = 16.0;
 
 impl Method {
-    /// The largest power N·P_S = |S|²/N that a frequency whose exact power
-    /// is 0 can show after this method's error, for sets of about `n`
-    /// points: (e·N)²/N with |ΔS| ≤ e·N, e = [`NUFFT_ERROR_FACTOR`]·ε for
-    /// the transform and [`DIRECT_ERROR_FACTOR`]·u for the direct sums.
-    /// Below it a power is indistinguishable from 0 (a lattice's empty
-    /// rings read 1e-33 to 1e-21, not 0).
-    pub fn power_floor(self, n: f64) -> f64 {
+    /// The bound on this method's error |ΔS(k)| for sets of (at most) `n`
+    /// points: [`NUFFT_ERROR_FACTOR`]·ε·n for the transform,
+    /// [`DIRECT_ERROR_FACTOR`]·u·n for the direct sums (u the unit
+    /// roundoff).
+    pub fn error_bound(self, n: f64) -> f64 {
         let e = match self {
             Method::Direct => DIRECT_ERROR_FACTOR * f64::EPSILON / 2.0,
             Method::Fast { tolerance } => NUFFT_ERROR_FACTOR * tolerance,
         };
+        e * n
+    }
+
+    /// The largest power N·P_S = |S|²/N that a frequency whose exact power
+    /// is 0 can show after this method's error, for sets of about `n`
+    /// points: [`Method::error_bound`]²/n. Below it a power is
+    /// indistinguishable from 0 (a lattice's empty rings read 1e-33 to
+    /// 1e-21, not 0).
+    pub fn power_floor(self, n: f64) -> f64 {
+        // (e·n)²/n as e·e·n: the bound per point, squared, once.
+        let e = self.error_bound(1.0);
         e * e * n
     }
 }

@@ -43,7 +43,7 @@
 //! Rounding: a set that integrates f exactly (uniform jitter on a smooth
 //! bump) has a Fourier variance of zero, and the computed one is what the
 //! arithmetic leaves. Two sources bound it. The transform's error is
-//! |ΔS(k)| ≤ e = 25·ε·N at tolerance ε (measured: [`NUFFT_ERROR_FACTOR`](crate::spectrum::expected::NUFFT_ERROR_FACTOR)), so
+//! |ΔS(k)| ≤ e = 25·ε·N at tolerance ε (measured: [`Method::error_bound`](crate::spectrum::Method::error_bound)), so
 //! N·P_S = |S|²/N is off by at most (2|S|·e + e²)/N per frequency, with
 //! E|S| ≤ √(E|S|²) (Jensen) from the expected power; weighted by P_f and
 //! summed over the box. The tail T = c_f(0) − Σ_(k∈B) P_f is a difference
@@ -415,7 +415,7 @@ fn assemble(
     });
     let rounding_bound = {
         let largest = counts.iter().copied().max().unwrap_or(0) as f64;
-        let e = crate::spectrum::expected::NUFFT_ERROR_FACTOR * tolerance * largest;
+        let e = crate::spectrum::Method::Fast { tolerance }.error_bound(largest);
         // Σ (2|S|·e + e²)/N·P_f with |S| = √(N·P_S): the two sums the box
         // pass gathered.
         let transform = (2.0 * e * root_weighted.value() * nf.sqrt() + e * e * mass.value()) / nf;
