@@ -444,8 +444,8 @@ fn power_colour_range(logs: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 /// Writes `map` as a PNG (viridis, colour bar on the right), atomically,
-/// with square cells: about 760×640 for a square grid, shorter for a wide
-/// one, narrower for a tall one (see [`frame_for_square_cells`]).
+/// with square cells: 760×609 for a square grid, shorter for a wide one,
+/// narrower for a tall one (see [`frame_for_square_cells`]).
 ///
 /// # Errors
 /// [`Error::Write`] naming `path` (also for an empty or ragged grid and for
