@@ -23,9 +23,11 @@
 //!   best slope is refined by Brent's method between scan points (a flat
 //!   spectrum, a hairline aperture's, weighs every column alike, and a
 //!   slope off by a scan step's 0.002 misses the far columns' peaks). Above
-//!   [`DOUBLE_WEDGE_MISFIT`] the spectrum is called a double wedge, and the
-//!   slope capturing most energy outside the first line's band
-//!   (|k_u − s·k_x| < 1) is the second layer.
+//!   [`DOUBLE_WEDGE_MISFIT`] the spectrum is called a double wedge; its
+//!   first line is the slope whose band (|k_u − s·k_x| < 1) holds the
+//!   largest mean share of the columns' energy, the second the slope
+//!   holding most of the columns where its band lies apart from the
+//!   first's.
 
 use nalgebra::{Matrix2, SymmetricEigen};
 
@@ -42,6 +44,10 @@ const CORE: f64 = 0.9;
 /// wedge (the misfit ranges over [0, 2]; tests/optimize_shear.rs measures
 /// single layers and two-layer mixtures on either side of it).
 const DOUBLE_WEDGE_MISFIT: f64 = 0.1;
+/// Columns holding at most this share of the strongest column's energy
+/// (a zero of the aperture's spectrum, or underflow) do not vote on a
+/// double wedge's lines.
+const COLUMN_FLOOR: f64 = 1e-12;
 /// Slopes closer than this are one direction.
 const MIN_SEPARATION: f64 = 0.15;
 /// Slope resolution of the line scan (finer slopes come from Brent's
@@ -242,24 +248,56 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
             |acc, c| if c.1 < acc.1 { c } else { acc },
         );
     let (fitted, one_line_misfit) = refine_slope(&misfit, scanned, step, limit);
+    // A line's hold on the columns: the mean over columns of the share of
+    // each column's energy within the band, counting only columns where the
+    // band lies apart from `other`'s (|s − other|·|k₁| ≥ 2). Columns weigh
+    // alike: near k₁ = 0, where most energy lies, a band of width 2 spans
+    // every slope within 1/|k₁| and two close layers share their cells; the
+    // far columns tell the slopes apart (energy-weighted shares read layers
+    // at 0.37 and 0.1 as 0.37 and −0.015, at 0.6 and 0.3 as 0.3 and −1.015).
+    let peak = columns.iter().map(|c| c.2).fold(0.0, f64::max);
+    let hold = |s: f64, other: Option<f64>| -> f64 {
+        let (mut total, mut counted) = (0.0, 0usize);
+        for &(k1, column, sum) in &columns {
+            if sum <= COLUMN_FLOOR * peak || other.is_some_and(|o| (s - o).abs() * k1.abs() < 2.0) {
+                continue;
+            }
+            let captured: f64 = column
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| in_band(s, k1, j as f64 - half as f64))
+                .map(|(_, &e)| e)
+                .sum();
+            total += captured / sum;
+            counted += 1;
+        }
+        if counted > 0 {
+            total / counted as f64
+        } else {
+            0.0
+        }
+    };
     // One line: the fitted slope. A double wedge: the fit lies between the
-    // layers, so the first line is the slope whose band holds the most
-    // energy (the strongest layer), the second the most of the rest.
+    // layers, so the first line is the slope holding the columns best (the
+    // strongest layer), the second the one holding best the columns where
+    // it lies apart from the first.
     let s1 = if one_line_misfit > DOUBLE_WEDGE_MISFIT {
         slopes
             .iter()
-            .map(|&s| (s, share(s, None)))
+            .map(|&s| (s, hold(s, None)))
             .fold((fitted, 0.0), |acc, c| if c.1 > acc.1 { c } else { acc })
             .0
     } else {
         fitted
     };
     let first_line_share = share(s1, None);
-    let (s2, second_line_share) = slopes
+    let s2 = slopes
         .iter()
         .filter(|&&s| (s - s1).abs() >= MIN_SEPARATION)
-        .map(|&s| (s, share(s, Some(s1))))
-        .fold((0.0, 0.0), |acc, c| if c.1 > acc.1 { c } else { acc });
+        .map(|&s| (s, hold(s, Some(s1))))
+        .fold((0.0, 0.0), |acc, c| if c.1 > acc.1 { c } else { acc })
+        .0;
+    let second_line_share = share(s2, Some(s1));
     let mut lines = vec![s1];
     if one_line_misfit > DOUBLE_WEDGE_MISFIT {
         lines.push(s2);
