@@ -16,12 +16,34 @@
 
 use std::path::Path;
 
-/// The budget in MiB.
+/// The environment variable that sets the budget.
+pub const BUDGET_VARIABLE: &str = "VARSPEC_MEMORY_MIB";
+
+/// The budget [`BUDGET_VARIABLE`] sets: `None` when it is unset.
+///
+/// # Errors
+/// A value that is not a whole number of MiB (`2MiB`, `1.5`, `-5`, empty),
+/// naming the variable: a budget the user believes is set must not be
+/// dropped silently for the automatic one.
+pub fn budget_from_env() -> Result<Option<u64>, String> {
+    match std::env::var_os(BUDGET_VARIABLE) {
+        None => Ok(None),
+        Some(raw) => {
+            let text = raw.to_string_lossy();
+            text.trim().parse::<u64>().map(Some).map_err(|_| {
+                format!(
+                    "{BUDGET_VARIABLE}={text:?} is not a whole number of MiB \
+                     (e.g. {BUDGET_VARIABLE}=4096); unset it for 80% of the available memory"
+                )
+            })
+        }
+    }
+}
+
+/// The budget in MiB ([`budget_from_env`] when it holds one; the command
+/// line refuses a malformed value before any work).
 pub fn limit_mib() -> u64 {
-    if let Some(v) = std::env::var("VARSPEC_MEMORY_MIB")
-        .ok()
-        .and_then(|v| v.trim().parse::<u64>().ok())
-    {
+    if let Ok(Some(v)) = budget_from_env() {
         return v;
     }
     headroom_bytes().map_or(8 * 1024, |b| b / (1 << 20) * 4 / 5)

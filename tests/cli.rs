@@ -1165,6 +1165,23 @@ fn sizes_beyond_memory_are_refused_before_allocating() {
             Some("1000"),
             "the closed-form expected power on the 8001^2 frequency box (|k| <= 4000) needs about 2443 MiB",
         ),
+        // A budget that does not parse is refused, not replaced silently by
+        // the automatic one (it was, and the command ran).
+        (
+            vec!["sample", "random", "-n", "16"],
+            Some("2MiB"),
+            "VARSPEC_MEMORY_MIB=\"2MiB\" is not a whole number of MiB",
+        ),
+        (
+            vec!["sample", "random", "-n", "16"],
+            Some("1.5"),
+            "VARSPEC_MEMORY_MIB=\"1.5\" is not a whole number of MiB",
+        ),
+        (
+            vec!["sample", "random", "-n", "16"],
+            Some(""),
+            "VARSPEC_MEMORY_MIB=\"\" is not a whole number of MiB",
+        ),
     ] {
         let out = run(&args, limit);
         let err = String::from_utf8_lossy(&out.stderr);

@@ -185,3 +185,26 @@ fn few_points_shrink_the_default_bandwidth_with_the_range() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A range given below 10 default bandwidths takes a tenth of it as the
+/// bandwidth, with a note (the default 0.15 was refused against
+/// `--range 0.001`, an option the user never gave); a bandwidth given is
+/// still checked against the range.
+#[test]
+fn a_small_range_given_takes_a_bandwidth_to_fit() {
+    let base = ["pcf", "--sampler", "jitter", "-n", "1024", "--sets", "1"];
+    for (range, note) in [
+        ("0.5", "note: --bandwidth 0.05 r_max (not 0.15)"),
+        ("0.001", "note: --bandwidth 0.001 r_max (not 0.15)"),
+    ] {
+        let out = crate::common::varspec_ok(&[&base[..], &["--range", range]].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(note), "--range {range}: {err}");
+        let rows = String::from_utf8_lossy(&out.stdout).lines().count();
+        assert_eq!(rows, 101, "--range {range}: header and 100 radii");
+    }
+    crate::common::assert_fails(
+        &[&base[..], &["--range", "0.1", "--bandwidth", "0.15"]].concat(),
+        "--bandwidth 0.15: the kernel's σ",
+    );
+}

@@ -72,7 +72,8 @@ pub struct DrawArgs {
     /// for any thread count.
     #[arg(value_parser = whole::<u64>, allow_negative_numbers = true, long = "seed", value_name = "SEED")]
     seed_given: Option<u64>,
-    /// Sampler parameter key=value (repeatable; see `varspec sample --list`).
+    /// Sampler parameter key=value (repeatable; see `varspec sample --list`;
+    /// wins over the same key in the NAME:key=value shorthand).
     #[arg(long = "param", value_parser = key_value)]
     pub params: Vec<(String, String)>,
 }

@@ -159,11 +159,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     };
     if levels.len() < 2 {
         bail!(
-            "{} needs at least two values to fit a slope",
+            "{} to fit a slope",
             if a.points.is_empty() {
-                "--n"
+                "--n needs at least two values"
             } else {
-                "--points"
+                "--points needs at least two files"
             }
         );
     }

@@ -112,6 +112,7 @@ pub fn main() -> ExitCode {
         None => Ok(()),
     };
     let result = varspec::io::all_or_nothing(|| {
+        varspec::memory::budget_from_env().map_err(anyhow::Error::msg)?;
         run(cli.command)?;
         stdout_failed()?;
         // "wrote …" only once the writes that can still fail have

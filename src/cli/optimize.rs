@@ -48,7 +48,7 @@ pub struct ShearArgs {
     seed: u64,
     /// Shears searched in [−range, range] on each axis [default: 2, or
     /// wider to hold the integrand spectrum's directions].
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     range: Option<f64>,
     /// Fresh realizations of the independent before/after check (0: skip it).
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 4000)]
@@ -115,14 +115,14 @@ pub struct PointsArgs {
     res: Option<usize>,
     /// NUFFT tolerance of the loss and gradient (the speed/accuracy knob;
     /// default 1e-6, as the blue-noise sampler).
-    #[arg(long, value_parser = args::tolerance)]
+    #[arg(allow_negative_numbers = true, long, value_parser = args::tolerance)]
     tol: Option<f64>,
     /// Stop when the loss improves by less than this, relatively, over 50
     /// iterations (default 1e-3 for blue-noise targets: the same variance on
     /// unseen disks and boxes as 1e-4 in half the time; 1e-4 for integrand
     /// and projection targets; 0: never). Not for --domain square, whose
     /// stochastic descent runs its --iters (2000) to the cap.
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     rel_tol: Option<f64>,
     /// The non-uniform FFT's upsampling factor σ: the fine grid has σ times
     /// the box's side per axis. `1.25` shrinks the FFT (2.6× in 2D) for a
@@ -159,7 +159,7 @@ pub struct PointsArgs {
     #[arg(long)]
     checkpoint: Option<PathBuf>,
     /// Least wall time between two checkpoint saves, in seconds.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(allow_negative_numbers = true, long, default_value_t = 60.0)]
     checkpoint_every: f64,
 }
 

@@ -23,15 +23,15 @@ pub struct Args {
     /// Largest radius, in units of the densest-packing distance r_max
     /// [default: 2.5, or less, with the bandwidth, where that would reach
     /// half the torus (few points)].
-    #[arg(long)]
+    #[arg(allow_negative_numbers = true, long)]
     range: Option<f64>,
     /// Radii evaluated in (0, range].
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 100)]
     bins: usize,
     /// Gaussian kernel standard deviation σ, in units of r_max [default:
     /// 0.15, or less, with the range, where the default range would reach
-    /// half the torus (few points)].
-    #[arg(long)]
+    /// half the torus (few points); a tenth of a --range below 1.5].
+    #[arg(allow_negative_numbers = true, long)]
     bandwidth: Option<f64>,
     /// CSV output: r,r_rel,g (r_rel = r / r_max). Default: standard output.
     #[arg(long)]
@@ -66,7 +66,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if a.bins == 0 {
         bail!("--bins 0: the number of radii must be at least 1 (default 100)");
     }
-    let mut bandwidth = a.bandwidth.unwrap_or(DEFAULT_BANDWIDTH);
+    // A range given below 10 default bandwidths takes a bandwidth spanning
+    // a tenth of it, as a shrunk default range does (the default 0.15 was
+    // refused against --range 0.001, an option the user never gave).
+    let mut bandwidth = a.bandwidth.unwrap_or_else(|| {
+        let fitted = (range / MIN_RANGE_IN_BANDWIDTHS).clamp(1e-3, DEFAULT_BANDWIDTH);
+        if fitted < DEFAULT_BANDWIDTH {
+            eprintln!(
+                "note: --bandwidth {fitted} r_max (not {DEFAULT_BANDWIDTH}): a tenth of --range \
+                 {range}, at least 0.001"
+            );
+        }
+        fitted.min(range)
+    });
     if !(bandwidth.is_finite() && bandwidth >= 1e-3 && bandwidth <= range) {
         bail!(
             "--bandwidth {:?}: the kernel's σ, in units of the packing distance r_max, must be in \

@@ -113,7 +113,7 @@ pub struct Args {
     #[arg(value_parser = super::args::frequency_box, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// NUFFT tolerance of the Fourier predictor's spectrum [default: 1e-10].
-    #[arg(long, value_parser = super::args::tolerance)]
+    #[arg(allow_negative_numbers = true, long, value_parser = super::args::tolerance)]
     tol: Option<f64>,
     /// Print one JSON object (the scripting interface).
     #[arg(long)]

@@ -53,7 +53,7 @@ pub struct Args {
     #[arg(short = 'o', long = "output", value_parser = super::args::png_path)]
     output: Option<PathBuf>,
     /// Multiplier before tone mapping.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     exposure: f64,
     /// Float image (PFM) of the (mean) image.
     #[arg(long)]
@@ -88,7 +88,8 @@ pub struct Args {
     /// Heat map PNG of the light-field slope κ each pixel's shear follows.
     #[arg(long, value_parser = super::args::png_path)]
     shear_png: Option<PathBuf>,
-    /// Sampler parameter key=value (repeatable).
+    /// Sampler parameter key=value (repeatable; wins over the same key in
+    /// the NAME:key=value shorthand).
     #[arg(long = "param", value_parser = args::key_value)]
     params: Vec<(String, String)>,
     /// List the built-in scenes (and nothing else: no scene is rendered).

@@ -64,7 +64,8 @@ pub struct Args {
     /// Number of independent realizations.
     #[arg(value_parser = args::whole_at_least::<1, usize>, allow_negative_numbers = true, long, default_value_t = args::DEFAULT_SETS)]
     sets: usize,
-    /// Sampler parameter key=value (repeatable; see --list).
+    /// Sampler parameter key=value (repeatable; see --list; wins over the
+    /// same key in the NAME:key=value shorthand).
     #[arg(long = "param", value_parser = args::key_value)]
     params: Vec<(String, String)>,
     /// Output file (default: standard output).

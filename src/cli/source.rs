@@ -40,7 +40,7 @@ pub struct SourceArgs {
     /// With a file of a random-count process (isotropic jitter): its
     /// density λ, the expected points per unit volume; estimators weigh
     /// points by 1/λ instead of 1/N.
-    #[arg(long, value_name = "LAMBDA")]
+    #[arg(allow_negative_numbers = true, long, value_name = "LAMBDA")]
     density: Option<f64>,
 }
 

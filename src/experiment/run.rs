@@ -272,14 +272,20 @@ fn check_memory(e: &Experiment, file: &str, items: usize) -> Result<(), Experime
                 .map(|(plan, len)| plan + 32.0 * len as f64)
         }
     };
-    crate::memory::check(
-        &format!("{} experiment items at once", at_once as usize),
-        radial.map(|r| at_once * (sets + r)),
-        "lower radial.half, n or sets, or run fewer threads (RAYON_NUM_THREADS)",
-    )
-    .map_err(|err| ExperimentError::Invalid {
-        file: file.to_string(),
-        reason: err.to_string(),
+    let what = match at_once as usize {
+        1 => "one experiment item".to_string(),
+        k => format!("{k} experiment items at once"),
+    };
+    let lower = if e.radial.is_some() {
+        "lower radial.half, n or sets, or run fewer threads (RAYON_NUM_THREADS)"
+    } else {
+        "lower n or sets, or run fewer threads (RAYON_NUM_THREADS)"
+    };
+    crate::memory::check(&what, radial.map(|r| at_once * (sets + r)), lower).map_err(|err| {
+        ExperimentError::Invalid {
+            file: file.to_string(),
+            reason: err.to_string(),
+        }
     })
 }
 

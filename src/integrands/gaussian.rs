@@ -1,4 +1,5 @@
-//! A periodized Gaussian bump of peak 1: f(x) = Σ_m g(x − c + m),
+//! The sum of the periodic images of a Gaussian of peak 1 (its own peak
+//! exceeds 1 once the images overlap): f(x) = Σ_m g(x − c + m),
 //! g(u) = exp(−½(a²/sx² + b²/sy²)) with a = u·e₁, b = u·e₂ in the frame
 //! rotated by θ.
 //!

@@ -65,7 +65,7 @@ pub const INTEGRANDS: &[IntegrandInfo] = &[
     IntegrandInfo {
         name: "gaussian",
         dim: 2,
-        summary: "periodized Gaussian bump of peak 1",
+        summary: "sum of the periodic images of a Gaussian of peak 1",
         params: &[
             (
                 "sx",
