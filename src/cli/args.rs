@@ -134,20 +134,67 @@ impl DrawArgs {
     }
 }
 
-/// A picture's path: the file is written as PNG, so a name ending in
-/// another extension (`--png s.csv`) is refused rather than filled with
-/// PNG bytes; no extension (`/dev/null`) is fine.
+/// A path for a file written in one format: a name ending in another
+/// extension (`--png s.csv`, `--pfm out.exr`) is refused rather than filled
+/// with `what`'s bytes; no extension (`/dev/null`) is fine.
+fn path_for(text: &str, ext: &str, what: &str) -> Result<std::path::PathBuf, String> {
+    if text.is_empty() {
+        return Err(format!(
+            "an empty file name: name the {what} file, e.g. out.{ext}"
+        ));
+    }
+    let path = std::path::PathBuf::from(text);
+    match path.extension().map(|e| e.to_string_lossy().to_lowercase()) {
+        Some(given) if given != ext => Err(format!(
+            "`{text}`: a {what} is written here (not .{given}); name the file .{ext}"
+        )),
+        _ => Ok(path),
+    }
+}
+
+/// A picture's path, written as PNG ([`path_for`]).
 ///
 /// # Errors
 /// A sentence naming the path.
 pub fn png_path(text: &str) -> Result<std::path::PathBuf, String> {
+    path_for(text, "png", "PNG picture")
+}
+
+/// A float image's path, written as PFM ([`path_for`]; `--pfm out.exr`
+/// wrote a PFM under an OpenEXR name).
+///
+/// # Errors
+/// A sentence naming the path.
+pub fn pfm_path(text: &str) -> Result<std::path::PathBuf, String> {
+    path_for(text, "pfm", "PFM float image")
+}
+
+/// A NumPy array's path, written as .npy ([`path_for`]).
+///
+/// # Errors
+/// A sentence naming the path.
+pub fn npy_path(text: &str) -> Result<std::path::PathBuf, String> {
+    path_for(text, "npy", "NumPy .npy array")
+}
+
+/// A point-set file's path: CSV, or NumPy .npy when the name ends in .npy.
+/// A name whose extension says another format (`t.npz`, `t.png`, `t.json`)
+/// would get CSV text under it, and is refused.
+///
+/// # Errors
+/// A sentence naming the path.
+pub fn point_file_path(text: &str) -> Result<std::path::PathBuf, String> {
+    const OTHER_FORMATS: [&str; 10] = [
+        "npz", "png", "jpg", "jpeg", "pfm", "exr", "json", "pdf", "svg", "h",
+    ];
     if text.is_empty() {
-        return Err("an empty file name: name the PNG file, e.g. points.png".into());
+        return Err("an empty file name: name the point-set file, e.g. points.csv".into());
     }
     let path = std::path::PathBuf::from(text);
     match path.extension().map(|e| e.to_string_lossy().to_lowercase()) {
-        Some(ext) if ext != "png" => Err(format!(
-            "`{text}`: a PNG picture is written here (not .{ext}); name the file .png"
+        Some(ext) if OTHER_FORMATS.contains(&ext.as_str()) => Err(format!(
+            "`{text}`: point sets are written as CSV (or UTK text with sample --format utk), or \
+             as NumPy .npy when the name ends in .npy, not as .{ext}; name the file .csv or .npy"
         )),
         _ => Ok(path),
     }

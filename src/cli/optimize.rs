@@ -54,7 +54,7 @@ pub struct ShearArgs {
     #[arg(value_parser = super::args::whole::<usize>, allow_negative_numbers = true, long, default_value_t = 4000)]
     realizations: usize,
     /// Write the sheared sets here (point-set CSV; NumPy .npy when the name ends in .npy).
-    #[arg(short = 'o', long = "output")]
+    #[arg(value_parser = args::point_file_path, short = 'o', long = "output")]
     output: Option<PathBuf>,
     /// Write XU and YV projection spectra before and after as PREFIX-{xu,yv}-{before,after}.png.
     #[arg(long)]
@@ -131,7 +131,7 @@ pub struct PointsArgs {
     #[arg(long, value_enum, default_value_t = UpsamplingArg::Auto)]
     upsampling: UpsamplingArg,
     /// Output point-set file (CSV; NumPy .npy when the name ends in .npy).
-    #[arg(short = 'o', long = "output")]
+    #[arg(value_parser = args::point_file_path, short = 'o', long = "output")]
     output: PathBuf,
     /// JSON report: loss curve, wall time, loss beside the classic samplers.
     #[arg(long)]

@@ -56,11 +56,11 @@ pub struct Args {
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     exposure: f64,
     /// Float image (PFM) of the (mean) image.
-    #[arg(long)]
+    #[arg(value_parser = super::args::pfm_path, long)]
     pfm: Option<PathBuf>,
     /// NumPy array (.npy, float64 [height, width], top row first) of the
     /// (mean) image.
-    #[arg(long)]
+    #[arg(value_parser = super::args::npy_path, long)]
     npy: Option<PathBuf>,
     /// Heat map PNG of log10 per-pixel variance, with a colour bar.
     #[arg(long, value_parser = super::args::png_path)]
@@ -71,10 +71,10 @@ pub struct Args {
     #[arg(long, value_name = "LO,HI", value_parser = log_range, requires = "variance_png", allow_hyphen_values = true)]
     variance_range: Option<(f64, f64)>,
     /// Float image (PFM) of the per-pixel variance.
-    #[arg(long)]
+    #[arg(value_parser = super::args::pfm_path, long)]
     variance_pfm: Option<PathBuf>,
     /// NumPy array (.npy, float64 [height, width]) of the per-pixel variance.
-    #[arg(long)]
+    #[arg(value_parser = super::args::npy_path, long)]
     variance_npy: Option<PathBuf>,
     /// Reference image (PFM) for the MSE in the summary.
     #[arg(long)]

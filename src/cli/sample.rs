@@ -69,7 +69,7 @@ pub struct Args {
     #[arg(long = "param", value_parser = args::key_value)]
     params: Vec<(String, String)>,
     /// Output file (default: standard output).
-    #[arg(short = 'o', long = "output")]
+    #[arg(value_parser = args::point_file_path, short = 'o', long = "output")]
     output: Option<PathBuf>,
     /// Output format (default: npy for an `-o` ending in .npy, else csv).
     #[arg(long, value_enum)]

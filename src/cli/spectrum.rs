@@ -51,7 +51,7 @@ pub struct Args {
     csv: Option<PathBuf>,
     /// NumPy float64 array [S, S] of the spectrum, S = 2h + 1 with h the
     /// largest |k| in the box: row k_y + h, column k_x + h (DC at the centre).
-    #[arg(long)]
+    #[arg(value_parser = super::args::npy_path, long)]
     npy: Option<PathBuf>,
     /// CSV of the radial profile: k,power,anisotropy.
     #[arg(long)]
