@@ -987,6 +987,16 @@ fn one_grammar_across_commands() {
     let long = String::from_utf8(out(&["integrands", "--list"])).unwrap();
     assert!(short.contains("layers") && !short.contains("c1=0.5"));
     assert!(long.contains("c1=0.5"));
+    // Scene pixels are integrands too; the lists and the commands taking
+    // them name the form (only spectrum --help and cli.md did).
+    for text in [
+        short,
+        long,
+        String::from_utf8(out(&["predict", "--help"])).unwrap(),
+        String::from_utf8(out(&["optimize", "shear", "--help"])).unwrap(),
+    ] {
+        assert!(text.contains("scene:NAME,px=X,py=Y"), "{text}");
+    }
     // Shell completions.
     let bash = String::from_utf8(out(&["completions", "bash"])).unwrap();
     assert!(bash.contains("varspec") && bash.contains("optimize"));

@@ -882,6 +882,16 @@ fn thin_multi_jittered_grids_are_named_and_get_no_theory_rate() {
     assert!(!String::from_utf8_lossy(&square.stderr).contains("grid"));
     let sample = common::varspec_ok(&["sample", "cmj", "-n", "251", "--sets", "1"]);
     assert!(String::from_utf8_lossy(&sample.stderr).contains("restores the grid"));
+    // Strips from a given m at a square N: the note names m, not N (it said
+    // 1024 had no divisor near √N and that N = 1024 restored the grid).
+    let given = common::varspec_ok(&["sample", "cmj:m=8", "-n", "1024", "--sets", "1"]);
+    let note = String::from_utf8_lossy(&given.stderr);
+    assert!(
+        note.contains("cmj N = 1024 with m = 8 is a 8 x 128 grid")
+            && note.contains("m = 32 (or m = auto) gives the 32 x 32 grid")
+            && !note.contains("no divisor"),
+        "{note}"
+    );
 }
 
 /// White noise's per-set values spread (a relative standard error near 9%

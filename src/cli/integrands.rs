@@ -30,6 +30,9 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             out += &format!("{:<10} {}D  {}\n", i.name, i.dim, i.summary);
         }
     }
+    out += "scene pixels (4D, no closed form): scene:NAME,px=X,py=Y with NAME a scene of \
+            `varspec render --list` or a scene file; for predict --method empirical, optimize \
+            shear and spectrum --integrand\n";
     out += "spec syntax: name:key=value,key=value (e.g. disk:r=0.3,cx=0.5,cy=0.5)";
     if !a.list {
         out += "; parameters: varspec integrands --list";

@@ -35,7 +35,8 @@ pub struct ShearArgs {
     /// Points per set.
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: usize,
-    /// 4D light field, e.g. defocus:shape=box,size=0.3,c=0.6 or layers:c1=0.5,c2=-0.2.
+    /// 4D light field, e.g. defocus:shape=box,size=0.3,c=0.6 or layers:c1=0.5,c2=-0.2,
+    /// or a scene pixel scene:NAME,px=X,py=Y.
     #[arg(long)]
     integrand: String,
     /// Sheared sets written with -o (the search itself uses the expected

@@ -80,7 +80,8 @@ pub struct Args {
     #[command(flatten)]
     source: SourceArgs,
     /// Integrand spec, e.g. disk:r=0.3 (see `varspec integrands --list`):
-    /// the torus and its shift-randomized estimator.
+    /// the torus and its shift-randomized estimator; or a scene pixel
+    /// scene:NAME,px=X,py=Y (--method empirical).
     #[arg(long, required_unless_present = "family", conflicts_with = "family")]
     integrand: Option<String>,
     /// Instead: a family of integrands on the unit square (gaussians,

@@ -345,7 +345,8 @@ pub struct HeatMap<'a> {
     /// Cells per row.
     pub width: usize,
     /// The axes' value ranges (left to right, bottom to top; a falling
-    /// y range numbers rows from the top, as image coordinates do).
+    /// y range numbers rows from the top, as image coordinates do), in
+    /// whole units (pixels, frequencies): only whole ticks are labelled.
     pub x_range: (f64, f64),
     /// See `x_range`.
     pub y_range: (f64, f64),
@@ -533,13 +534,17 @@ fn frame_for_square_cells(map: &HeatMap, aspect: f64) -> std::io::Result<(u32, u
     Ok((w, h))
 }
 
-/// A colour range that spans something: a constant field (every pixel's
-/// shear 0) gets v ± 1 instead of a bar whose ticks all read the same.
+/// A colour range that spans something: a field constant to a thousandth
+/// of its size (every pixel's shear 0; a row of equal variances that
+/// differ by rounding) gets its middle ± 1 instead of a bar whose ticks
+/// all read the same (eleven ticks of −1.9488).
 fn colour_span((lo, hi): (f64, f64)) -> (f64, f64) {
-    if hi > lo {
+    let flat = 1e-3 * lo.abs().max(hi.abs()).max(1.0);
+    if hi - lo > flat {
         (lo, hi)
-    } else if lo.is_finite() {
-        (lo - 1.0, lo + 1.0)
+    } else if lo.is_finite() && hi.is_finite() {
+        let mid = 0.5 * (lo + hi);
+        (mid - 1.0, mid + 1.0)
     } else {
         (-1.0, 1.0)
     }
@@ -596,10 +601,23 @@ fn draw_heatmap_frame(
         .y_label_area_size(72)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(draw_error)?;
+    // The axes count pixels or frequencies: whole numbers only, and no more
+    // labels than whole numbers in the range (an image one pixel high was
+    // labelled 0.1, 0.2, …).
+    let whole = |v: &f64| {
+        if (v - v.round()).abs() < 1e-9 {
+            tick_number(v.round())
+        } else {
+            String::new()
+        }
+    };
+    let labels = |a: f64, b: f64| ((a - b).abs().floor() as usize + 1).clamp(2, 10);
     heat.configure_mesh()
         .disable_mesh()
-        .x_label_formatter(&|v| tick_number(*v))
-        .y_label_formatter(&|v| tick_number(*v))
+        .x_labels(labels(x0, x1))
+        .y_labels(labels(y0, y1))
+        .x_label_formatter(&whole)
+        .y_label_formatter(&whole)
         .x_desc(map.x_label.as_str())
         .y_desc(map.y_label.as_str())
         .label_style(("sans-serif", 15))
@@ -701,6 +719,9 @@ mod tests {
         assert_eq!(tick_number(0.125), "0.125");
         assert_eq!(colour_span((0.0, 0.0)), (-1.0, 1.0));
         assert_eq!(colour_span((-3.0, -2.0)), (-3.0, -2.0));
+        // Equal to rounding (a row of equal variances): the middle ± 1.
+        let (lo, hi) = colour_span((-1.948_847_3, -1.948_847_1));
+        assert!((lo + 2.948_847_2).abs() < 1e-12 && (hi + 0.948_847_2).abs() < 1e-12);
     }
 
     #[test]

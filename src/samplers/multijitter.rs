@@ -133,18 +133,35 @@ impl Sampler for MultiJitter {
         let (m, rows) = (self.columns.min(self.rows), self.columns.max(self.rows));
         (4 * m < rows).then(|| {
             let n = self.points_per_set();
-            let square = (n as f64).sqrt().round() as usize;
-            format!(
-                "{} N = {n} is a {m} x {rows} grid (N has no divisor near √N): its strata are \
-                 strips, it converges like N-rooks rather than a 2D grid; N = {} (or any m·n \
-                 with m near √N) restores the grid",
-                if self.correlated {
-                    "cmj"
-                } else {
-                    "multijitter"
-                },
-                square * square
-            )
+            let name = if self.correlated {
+                "cmj"
+            } else {
+                "multijitter"
+            };
+            // The grid `m = auto` picks: the divisor of N nearest below √N.
+            let nearest = (1..=n)
+                .take_while(|d| d * d <= n)
+                .filter(|d| n % d == 0)
+                .last()
+                .unwrap_or(1);
+            if 4 * nearest < n / nearest {
+                let square = (n as f64).sqrt().round() as usize;
+                format!(
+                    "{name} N = {n} is a {m} x {rows} grid (N has no divisor near √N): its \
+                     strata are strips, it converges like N-rooks rather than a 2D grid; \
+                     N = {} (or any m·n with m near √N) restores the grid",
+                    square * square
+                )
+            } else {
+                // The strips are the given m's (`--param m=8` at N = 1024).
+                format!(
+                    "{name} N = {n} with m = {} is a {m} x {rows} grid: its strata are strips, \
+                     it converges like N-rooks rather than a 2D grid; m = {nearest} (or m = \
+                     auto) gives the {nearest} x {} grid",
+                    self.columns,
+                    n / nearest
+                )
+            }
         })
     }
 }

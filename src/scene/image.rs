@@ -174,6 +174,7 @@ impl GreyImage {
             .iter()
             .map(|&v| if v > 0.0 { v.log10() } else { f64::NAN })
             .collect();
+        let all_zero = logs.iter().all(|v| v.is_nan());
         let (lo, hi) = colour_range.unwrap_or_else(|| {
             let mut finite: Vec<f64> = logs.iter().copied().filter(|v| v.is_finite()).collect();
             if finite.is_empty() {
@@ -184,9 +185,16 @@ impl GreyImage {
             let hi = at(0.999);
             (at(0.01).max(hi - 6.0), hi)
         });
+        // Every pixel grey: the bar's range maps nothing, and the title says
+        // why.
+        let title = if all_zero {
+            format!("{title} (every pixel's variance is 0)")
+        } else {
+            title.to_string()
+        };
         heatmap_png(
             &HeatMap {
-                title: title.into(),
+                title,
                 values: &logs,
                 width: self.width,
                 x_range: (0.0, self.width as f64),
@@ -194,7 +202,9 @@ impl GreyImage {
                 x_label: "pixel x".into(),
                 y_label: "pixel y (from the top)".into(),
                 bar_label: "log10 variance (grey: 0)".into(),
-                colour_range: (lo, hi.max(lo + 1e-9)),
+                // A constant field (lo = hi) is drawn at the middle of v ± 1
+                // by the heat map (a 1e-9 span gave eleven equal ticks).
+                colour_range: (lo, hi),
             },
             path,
         )
