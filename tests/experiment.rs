@@ -601,6 +601,21 @@ fn figure_experiments_refuse_what_they_cannot_draw() {
             scene.replace("\"renders\": 16", "\"renders\": 1"),
             "figures[0]: renders = 1 must be in 2 ..= 4096",
         ),
+        // A value of the wrong type inside a figure (an internally tagged
+        // object) names its field; it named only figures[0] and the
+        // object's closing brace.
+        (
+            scene.replace("\"renders\": 16", "\"renders\": [16]"),
+            "figures[0].renders: invalid type: sequence, expected usize",
+        ),
+        (
+            scene.replace("\"renders\": 16", "\"renders\": \"x\""),
+            "figures[0].renders: invalid type: string \"x\", expected usize",
+        ),
+        (
+            scene.replace("\"renders\": 16", "\"renders\": -16"),
+            "figures[0].renders: invalid value: integer `-16`, expected usize",
+        ),
         (
             scene.replace("\"scene\": \"dof\"", "\"scene\": \"nosuch.json\""),
             "figures[0]: ",

@@ -227,6 +227,13 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
             "",
             "objects[0].material: missing field `low` of a `checker` texture",
         ),
+        // A material that is not an object says what one is (it named the
+        // reader's own type, `struct MaterialFields`).
+        (
+            "{\"texture\": \"checker\", \"period\": 0.8, \"low\": 0.15, \"high\": 0.85}",
+            "0.5",
+            "objects[0].material: invalid type: floating point `0.5`, expected a material: an object with `texture`",
+        ),
         (
             "\"resolution\": [256, 256]",
             "\"resolution\": [256, 256, 3]",

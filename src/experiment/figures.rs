@@ -62,7 +62,12 @@ pub struct FigureExperiment {
 
 /// One figure.
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
-#[serde(tag = "figure", rename_all = "kebab-case", deny_unknown_fields)]
+#[serde(
+    tag = "figure",
+    rename_all = "kebab-case",
+    deny_unknown_fields,
+    expecting = "a figure: an object `{ \"figure\": KIND, ... }`"
+)]
 pub enum Figure {
     /// Radially averaged E[N·P_S] of 2D samplers on one plot (Pilleboue et
     /// al. 2015, §4: the radial profile of an isotropic spectrum).

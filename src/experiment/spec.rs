@@ -73,7 +73,7 @@ pub struct Experiment {
 
 /// The radial predictor's box (`"radial": {"half": 255}`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "radial: an object `{ \"half\": K }`")]
 pub struct RadialComparison {
     /// The radial and Fourier forms' box |k|∞ ≤ half.
     pub half: usize,

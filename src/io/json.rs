@@ -39,6 +39,9 @@ pub fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, String> {
         // message's line and column say where.
         let full = e.path().to_string();
         let path = full.trim_end_matches('?').trim_end_matches('.');
+        if let Some(located) = field_in_tagged_object::<T>(text, path) {
+            return located;
+        }
         let message = plain_message(e.inner(), text);
         if path.is_empty() {
             message
@@ -48,6 +51,82 @@ pub fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, String> {
     })?;
     de.end().map_err(|e| e.to_string())?;
     Ok(value)
+}
+
+/// The field of a wrong type inside an internally tagged enum's object
+/// (`{"figure": "scene-samplers", "spp": [16]}`), whose fields serde reads
+/// from a buffer the path tracking does not see: the error names only the
+/// object (`figures[0]`) and the position of its end. The culprit is the
+/// first key whose value is the one the error describes (`sequence`,
+/// `string "x"`, `integer `-4``) and whose removal changes the error: the
+/// entries are read in order and a wrong type stops the reading before any
+/// missing field is noticed, so removing another key leaves the same error
+/// (but the tag's, whose removal loses the variant; its value is a name,
+/// not the value described). `None` when the error is not of that kind or
+/// no key explains it.
+fn field_in_tagged_object<T: DeserializeOwned>(text: &str, path: &str) -> Option<String> {
+    let root: serde_json::Value = serde_json::from_str(text).ok()?;
+    let error_of = |value: serde_json::Value| {
+        serde_path_to_error::deserialize::<_, T>(value)
+            .err()
+            .map(|e| (e.path().to_string(), e.inner().to_string()))
+    };
+    let (original_path, original) = error_of(root.clone())?;
+    if original_path.trim_end_matches(['?', '.']) != path
+        || !(original.starts_with("invalid type") || original.starts_with("invalid value"))
+    {
+        return None;
+    }
+    let pointer = json_pointer(path)?;
+    let keys: Vec<String> = root
+        .pointer(&pointer)?
+        .as_object()?
+        .keys()
+        .cloned()
+        .collect();
+    let object = root.pointer(&pointer)?.as_object()?;
+    keys.into_iter()
+        .filter(|key| original.contains(&unexpected(&object[key.as_str()])))
+        .find_map(|key| {
+            let mut trial = root.clone();
+            trial.pointer_mut(&pointer)?.as_object_mut()?.remove(&key);
+            (error_of(trial).map(|e| e.1) != Some(original.clone()))
+                .then(|| format!("{path}.{key}: {original}"))
+        })
+}
+
+/// How serde's "invalid type" and "invalid value" errors describe a JSON
+/// value (serde::de::Unexpected's wording).
+fn unexpected(value: &serde_json::Value) -> String {
+    use serde_json::Value;
+    match value {
+        Value::Null => "unit value".into(),
+        Value::Bool(b) => format!("boolean `{b}`"),
+        Value::Number(n) if n.is_f64() => format!("floating point `{n}`"),
+        Value::Number(n) => format!("integer `{n}`"),
+        Value::String(s) => format!("string {s:?}"),
+        Value::Array(_) => "sequence".into(),
+        Value::Object(_) => "map".into(),
+    }
+}
+
+/// A serde_path_to_error path (`figures[0].scene`) as a JSON pointer
+/// (`/figures/0/scene`); `None` for a path with an unknown segment.
+fn json_pointer(path: &str) -> Option<String> {
+    let mut pointer = String::new();
+    for part in path.split('.').filter(|p| !p.is_empty()) {
+        let (name, indices) = part.split_once('[').map_or((part, ""), |(n, i)| (n, i));
+        if name == "?" {
+            return None;
+        }
+        if !name.is_empty() {
+            pointer += &format!("/{}", name.replace('~', "~0").replace('/', "~1"));
+        }
+        for index in indices.split('[').filter(|i| !i.is_empty()) {
+            pointer += &format!("/{}", index.trim_end_matches(']'));
+        }
+    }
+    Some(pointer)
 }
 
 /// serde_json's message for an error below the top level, in a file

@@ -36,7 +36,10 @@ pub enum IntegrandKind {
 
 /// A thin-lens camera with a square aperture.
 #[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a camera: an object with `resolution`, `fov_degrees`, `position`, `look_at`, `focal_distance` and `aperture`"
+)]
 pub struct CameraFile {
     /// Image width and height in pixels.
     pub resolution: [usize; 2],
@@ -61,7 +64,10 @@ fn default_up() -> [f64; 3] {
 
 /// One mesh.
 #[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "an object: `{ \"shape\": ..., \"material\": ... }`"
+)]
 pub struct ObjectFile {
     /// Built-in shape: `quad` ([−1, 1]² in the xy plane, normal +z),
     /// `box` ([−1, 1]³) or `sphere` (unit radius, tessellated); or `obj`, a
@@ -153,7 +159,10 @@ pub enum MaterialFile {
 /// serde's internally tagged enums lose; [`MaterialFile::try_from`] then
 /// checks that the fields are the texture's own.
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a material: an object with `texture` (constant, checker or stripes) and its fields"
+)]
 struct MaterialFields {
     texture: TextureKind,
     albedo: Option<f64>,
@@ -223,7 +232,10 @@ impl MaterialFields {
 
 /// An emitting square or disk, one-sided, facing `normal`.
 #[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a light: an object with `shape` and its fields"
+)]
 pub struct LightFile {
     /// `square` or `disk`.
     pub shape: LightShape,
