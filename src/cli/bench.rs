@@ -357,13 +357,14 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     let mut out: Vec<RenderRow> = Vec::new();
     outln!(
-        "{:<6} {:>10} {:>8} {:>12} {:>18} {:>18}",
+        "{:<6} {:>10} {:>8} {:>12} {:>18} {:>18} {:>12}",
         "bvh",
         "triangles",
         "threads",
         "build (s)",
         "camera rays/s",
-        "shadow rays/s"
+        "shadow rays/s",
+        "camera hits"
     );
     for (label, kind) in [("cwbvh", BvhKind::Cwbvh), ("bvh2", BvhKind::Bvh2)] {
         let start = Instant::now();
@@ -420,7 +421,7 @@ fn render(a: RenderArgs) -> anyhow::Result<()> {
             points.len() as f64 / shadow_seconds,
         );
         outln!(
-            "{label:<6} {:>10} {threads:>8} {build:>12.3} {camera_rate:>18.3e} {shadow_rate:>18.3e}",
+            "{label:<6} {:>10} {threads:>8} {build:>12.3} {camera_rate:>18.3e} {shadow_rate:>18.3e} {hits:>12}",
             scene.geometry().triangle_count()
         );
         out.push(RenderRow {
