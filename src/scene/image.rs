@@ -51,7 +51,8 @@ impl GreyImage {
     }
 
     /// Reads a grey PFM written by [`Self::write_pfm`] or another tool
-    /// (either byte order).
+    /// (either byte order), or a colour one whose channels are equal at
+    /// every pixel.
     ///
     /// # Errors
     /// A sentence naming what is wrong with the file.
@@ -59,7 +60,8 @@ impl GreyImage {
         let limit = crate::memory::limit_mib().saturating_mul(1 << 20);
         let bytes = crate::io::read_bounded(path, limit, "a PFM image")
             .map_err(|e| format!("{}: {e}", path.display()))?;
-        let bad = |what: &str| format!("{}: not a grey PFM image: {what}", path.display());
+        let bad =
+            |what: &str| format!("{}: not a PFM image of grey values: {what}", path.display());
         // Three whitespace-separated header tokens after `Pf`, then one
         // whitespace byte, then the data.
         let mut fields = Vec::new();
@@ -78,9 +80,17 @@ impl GreyImage {
             fields.push(String::from_utf8_lossy(&bytes[start..i]).into_owned());
         }
         i += 1;
-        if fields[0] != "Pf" {
-            return Err(bad(&format!("magic `{}`, expected `Pf`", fields[0])));
-        }
+        // `PF` (colour) is read when its three channels agree at every
+        // pixel: a grey image as other renderers write it.
+        let channels = match fields[0].as_str() {
+            "Pf" => 1,
+            "PF" => 3,
+            other => {
+                return Err(bad(&format!(
+                    "magic `{other}`, expected `Pf` (grey) or `PF` (colour)"
+                )));
+            }
+        };
         let parse = |s: &str| {
             s.parse::<usize>()
                 .ok()
@@ -97,11 +107,11 @@ impl GreyImage {
                 bad("scale is not a nonzero number (its sign is the byte order: < 0 little-endian)")
             })?;
         let data = bytes.get(i..).unwrap_or_default();
-        if data.len() != 4 * width * height {
+        if data.len() != 4 * channels * width * height {
             return Err(bad(&format!(
-                "{} data bytes where {width}×{height} needs {}",
+                "{} data bytes where {width}×{height}×{channels} needs {}",
                 data.len(),
-                4 * width * height
+                4 * channels * width * height
             )));
         }
         let value = |c: &[u8]| {
@@ -113,10 +123,37 @@ impl GreyImage {
             })
         };
         let rows: Vec<Vec<f64>> = data
-            .chunks_exact(4 * width)
+            .chunks_exact(4 * channels * width)
             .map(|row| row.chunks_exact(4).map(value).collect())
             .collect();
         // PFM rows run bottom to top.
+        let rows = rows
+            .into_iter()
+            .enumerate()
+            .map(|(r, row)| {
+                if channels == 1 {
+                    return Ok(row);
+                }
+                row.chunks_exact(3)
+                    .enumerate()
+                    .map(|(x, rgb)| {
+                        // NaN channels are refused below, as a grey one is.
+                        if rgb[0].to_bits() == rgb[1].to_bits()
+                            && rgb[1].to_bits() == rgb[2].to_bits()
+                        {
+                            Ok(rgb[0])
+                        } else {
+                            Err(bad(&format!(
+                                "a colour PFM whose channels differ at pixel ({x}, {}): {:?}; \
+                                 the renderer's images are grey (give one channel, or equal ones)",
+                                height - 1 - r,
+                                rgb
+                            )))
+                        }
+                    })
+                    .collect()
+            })
+            .collect::<Result<Vec<Vec<f64>>, String>>()?;
         for (r, row) in rows.iter().enumerate() {
             if let Some(x) = row.iter().position(|v| !v.is_finite()) {
                 return Err(bad(&format!(
@@ -245,6 +282,40 @@ mod tests {
         let mut bytes = Vec::new();
         image.pfm(&mut bytes).unwrap();
         assert_eq!(read(&bytes).unwrap(), image);
+    }
+
+    /// A colour PFM (pbrt's, say) of a grey image reads as that image; one
+    /// whose channels differ is refused at the pixel (two rows, so the
+    /// pixel's y counts from the top as the renderer's do).
+    #[test]
+    fn a_colour_pfm_of_equal_channels_reads_as_grey() {
+        let colour = |rgb: [[f32; 3]; 2]| {
+            // Two rows of one pixel, written bottom row first.
+            let mut bytes = b"PF\n1 2\n-1.0\n".to_vec();
+            for v in rgb.iter().flatten() {
+                bytes.extend(v.to_le_bytes());
+            }
+            bytes
+        };
+        let image = read(&colour([[0.25; 3], [1.5; 3]])).unwrap();
+        assert_eq!(
+            image,
+            GreyImage {
+                width: 1,
+                height: 2,
+                pixels: vec![1.5, 0.25],
+            }
+        );
+        let e = read(&colour([[0.25, 0.25, 0.3], [1.5; 3]])).unwrap_err();
+        assert!(
+            e.contains("a colour PFM whose channels differ at pixel (0, 1): [0.25, 0.25, 0.30000001192092896]"),
+            "{e}"
+        );
+        let e = read(b"P6\n1 1\n-1.0\n\0\0\0\0").unwrap_err();
+        assert!(
+            e.contains("magic `P6`, expected `Pf` (grey) or `PF` (colour)"),
+            "{e}"
+        );
     }
 
     #[test]
