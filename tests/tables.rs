@@ -884,6 +884,59 @@ fn a_table_converted_from_a_table_keeps_its_provenance() {
         "{meta}"
     );
     assert!(note.contains("does not describe"), "{note}");
+    // A table whose own metadata no longer describes its values (one value
+    // edited by hand) is not carried either, and a note names which
+    // metadata it was (they were dropped without a word).
+    for (format, name, values, place) in [
+        (
+            "c-header",
+            "edited.h",
+            "= {",
+            "the `metadata (JSON)` line of",
+        ),
+        (
+            "json",
+            "edited.json",
+            "\"sets\":[[[",
+            "the `metadata` field of",
+        ),
+    ] {
+        varspec(&[
+            "tables",
+            "--sampler",
+            "cmj",
+            "-n",
+            "4",
+            "--sets",
+            "1",
+            "--seed",
+            "3",
+            "--format",
+            format,
+            "-o",
+            &t(name),
+        ]);
+        // The first value after the metadata, 0.0876…, becomes 0.50876….
+        let mut text = std::fs::read_to_string(d.join(name)).unwrap();
+        let array = text.find(values).unwrap();
+        let first = array + text[array..].find("0.").unwrap();
+        text.replace_range(first..first + 2, "0.5");
+        std::fs::write(d.join(name), &text).unwrap();
+        let note = varspec(&["tables", "--from", &t(name), "-o", &t("from-edited.json")]);
+        let meta = crate::common::read_json(&d.join("from-edited.json"))["metadata"].clone();
+        assert_eq!(
+            (&meta["source"], &meta["seed"]),
+            (&t(name).into(), &serde_json::Value::Null),
+            "{format}: {meta}"
+        );
+        assert!(
+            note.contains(&format!(
+                "note: {place} {} does not describe its values",
+                t(name)
+            )),
+            "{format}: {note}"
+        );
+    }
     // The input's sidecar is an input too: writing it is refused.
     crate::common::assert_fails(
         &[

@@ -151,19 +151,16 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                 );
             }
             run_seed = None;
-            let (sets, meta) = read_point_sets_with_metadata(path)?;
-            if meta.is_none()
-                && let Some(stale) = from_sidecar.as_deref().filter(|p| p.is_file())
-            {
+            let (sets, found) = read_point_sets_with_metadata(path)?;
+            if let Some(stale) = &found.stale {
                 eprintln!(
-                    "note: {} does not describe {} (unreadable, or written for other points): \
-                     its provenance is not carried; the table records the file's path as its \
-                     source and no seed",
-                    stale.display(),
+                    "note: {stale} of {} does not describe its values (unreadable, or they were \
+                     edited or written over since): its provenance is not carried; the table \
+                     records the file's path as its source and no seed",
                     path.display()
                 );
             }
-            carried = meta;
+            carried = found.describing;
             (sets, path.display().to_string())
         }
         (None, None) => bail!("give --sampler or --from"),

@@ -220,17 +220,45 @@ pub fn read_point_sets(path: &Path) -> Result<Vec<PointSet>, PointFileError> {
     read_point_sets_with_metadata(path).map(|(sets, _)| sets)
 }
 
-/// As [`read_point_sets`], with the metadata of a varspec table that
-/// describes the sets read ([`tables::describes`]: the same N, d and count,
-/// and the values' digest where it records one; a stale one is left out):
-/// a JSON table's own, a C header's `metadata (JSON)` comment line, or a
-/// sidecar `PATH.json`. `None` for other files.
+/// The metadata of a varspec table found with a point-set file: a JSON
+/// table's own, a C header's `metadata (JSON)` comment line, or a sidecar
+/// `PATH.json`.
+#[derive(Debug, Default)]
+pub struct FoundMetadata {
+    /// Metadata that describes the sets read ([`tables::describes`]: the
+    /// same N, d and count, and the values' digest where it records one).
+    pub describing: Option<TableMetadata>,
+    /// Where metadata was found that does not describe them (values edited
+    /// or written over since, or a sidecar that cannot be read), to say
+    /// that it is not carried.
+    pub stale: Option<String>,
+}
+
+impl FoundMetadata {
+    /// `meta`, found at `place`, sorted by whether it describes `sets`.
+    fn sorted(meta: Option<TableMetadata>, place: String, sets: &[PointSet]) -> Self {
+        match meta {
+            Some(m) if tables::describes(&m, sets) => FoundMetadata {
+                describing: Some(m),
+                stale: None,
+            },
+            Some(_) => FoundMetadata {
+                describing: None,
+                stale: Some(place),
+            },
+            None => FoundMetadata::default(),
+        }
+    }
+}
+
+/// As [`read_point_sets`], with the table metadata found with the file
+/// ([`FoundMetadata`]; none for other files).
 ///
 /// # Errors
 /// As [`read_point_sets`].
 pub fn read_point_sets_with_metadata(
     path: &Path,
-) -> Result<(Vec<PointSet>, Option<TableMetadata>), PointFileError> {
+) -> Result<(Vec<PointSet>, FoundMetadata), PointFileError> {
     let io = |cause| PointFileError::Io {
         path: path.into(),
         cause,
@@ -250,18 +278,22 @@ pub fn read_point_sets_with_metadata(
         // are these.
         return tables::read_raw(reader, len, raw, meta)
             .map(|sets| {
-                let meta = tables::describes(meta, &sets).then(|| meta.clone());
-                (sets, meta)
+                let found = FoundMetadata::sorted(Some(meta.clone()), sidecar_place(path), &sets);
+                (sets, found)
             })
             .map_err(table);
     }
     let head = reader.fill_buf().map_err(io)?;
     let described = |sets: Vec<PointSet>| {
-        let meta = match &sidecar {
-            Some(Ok(meta)) if tables::describes(meta, &sets) => Some(meta.clone()),
-            _ => None,
+        let found = match &sidecar {
+            Some(Ok(meta)) => FoundMetadata::sorted(Some(meta.clone()), sidecar_place(path), &sets),
+            Some(Err(_)) => FoundMetadata {
+                describing: None,
+                stale: Some(sidecar_place(path)),
+            },
+            None => FoundMetadata::default(),
         };
-        (sets, meta)
+        (sets, found)
     };
     if head.starts_with(npy::MAGIC) {
         return npy::read_point_sets_npy(reader)
@@ -282,15 +314,20 @@ pub fn read_point_sets_with_metadata(
             reader.consume(BOM.len());
         }
         if json {
-            return tables::read_json_table(reader).map_err(table);
+            return tables::read_json_table(reader)
+                .map(|(sets, meta)| {
+                    let found = FoundMetadata::sorted(meta, "the `metadata` field".into(), &sets);
+                    (sets, found)
+                })
+                .map_err(table);
         }
         let mut text = String::new();
         reader.read_to_string(&mut text).map_err(io)?;
         return tables::read_c_header(&text)
             .map(|sets| {
-                let meta = tables::read_c_header_metadata(&text)
-                    .filter(|meta| tables::describes(meta, &sets));
-                (sets, meta)
+                let meta = tables::read_c_header_metadata(&text);
+                let found = FoundMetadata::sorted(meta, "the `metadata (JSON)` line".into(), &sets);
+                (sets, found)
             })
             .map_err(table);
     }
@@ -309,6 +346,11 @@ pub fn read_point_sets_with_metadata(
         (e, _) => e,
     })?;
     Ok(described(sets))
+}
+
+/// How a note names `path`'s sidecar.
+fn sidecar_place(path: &Path) -> String {
+    format!("the sidecar {}", tables::sidecar_path(path).display())
 }
 
 /// Reads `path` and checks that its points have dimension `dim`.

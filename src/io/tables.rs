@@ -487,9 +487,9 @@ pub fn read_json_table(
             meta.dim
         ));
     }
-    // Values edited since the metadata was written: no provenance.
-    let metadata = table.metadata.filter(|meta| describes(meta, &sets));
-    Ok((sets, metadata))
+    // Values edited since the metadata was written are told by the
+    // caller ([`describes`]).
+    Ok((sets, table.metadata))
 }
 
 /// Whether `meta` has the shape of `sets` (its N, d and count).
