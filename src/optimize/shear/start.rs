@@ -18,16 +18,16 @@
 //!   is near 0 for one layer (only the box edge truncates the profile) and
 //!   large when the energy splits between two directions: the seed's
 //!   double wedge, where no single shear fits both layers (its lines are
-//!   then the slopes whose bands hold the most energy). Where the line
+//!   then found as below). Where the line
 //!   leaves the box the model keeps the profile's share inside it, and the
 //!   best slope is refined by Brent's method between scan points (a flat
 //!   spectrum, a hairline aperture's, weighs every column alike, and a
 //!   slope off by a scan step's 0.002 misses the far columns' peaks). Above
-//!   [`DOUBLE_WEDGE_MISFIT`] the spectrum is called a double wedge; its
-//!   first line is the slope whose band (|k_u − s·k_x| < 1) holds the
-//!   largest mean share of the columns' energy, the second the slope
-//!   holding most of the columns where its band lies apart from the
-//!   first's.
+//!   [`DOUBLE_WEDGE_MISFIT`] the spectrum is called a double wedge; one
+//!   line is the slope whose band (|k_u − s·k_x| < 1) holds the largest
+//!   mean share of the energy of the columns it crosses inside the box, the
+//!   other the slope holding most of the columns where its band lies apart
+//!   from the first's; the line whose band holds more energy is the first.
 
 use nalgebra::{Matrix2, SymmetricEigen};
 
@@ -259,7 +259,13 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
     let hold = |s: f64, other: Option<f64>| -> f64 {
         let (mut total, mut counted) = (0.0, 0usize);
         for &(k1, column, sum) in &columns {
-            if sum <= COLUMN_FLOOR * peak || other.is_some_and(|o| (s - o).abs() * k1.abs() < 2.0) {
+            // Columns where the band has left the box do not vote (a steep
+            // layer scored 0 there and lost the first place to a shallow
+            // one of a third of its energy).
+            if sum <= COLUMN_FLOOR * peak
+                || (s * k1).abs() > half as f64 + 1.0
+                || other.is_some_and(|o| (s - o).abs() * k1.abs() < 2.0)
+            {
                 continue;
             }
             let captured: f64 = column
@@ -278,9 +284,10 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
         }
     };
     // One line: the fitted slope. A double wedge: the fit lies between the
-    // layers, so the first line is the slope holding the columns best (the
-    // strongest layer), the second the one holding best the columns where
-    // it lies apart from the first.
+    // layers, so one line is the slope holding the columns best, the other
+    // the one holding best the columns where it lies apart from the first;
+    // the one whose band holds more energy (the strongest layer) is
+    // reported first.
     let s1 = if one_line_misfit > DOUBLE_WEDGE_MISFIT {
         slopes
             .iter()
@@ -290,13 +297,18 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
     } else {
         fitted
     };
-    let first_line_share = share(s1, None);
     let s2 = slopes
         .iter()
         .filter(|&&s| (s - s1).abs() >= MIN_SEPARATION)
         .map(|&s| (s, hold(s, Some(s1))))
         .fold((0.0, 0.0), |acc, c| if c.1 > acc.1 { c } else { acc })
         .0;
+    let (s1, s2) = if one_line_misfit > DOUBLE_WEDGE_MISFIT && share(s2, None) > share(s1, None) {
+        (s2, s1)
+    } else {
+        (s1, s2)
+    };
+    let first_line_share = share(s1, None);
     let second_line_share = share(s2, Some(s1));
     let mut lines = vec![s1];
     if one_line_misfit > DOUBLE_WEDGE_MISFIT {
