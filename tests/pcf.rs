@@ -195,6 +195,7 @@ fn a_small_range_given_takes_a_bandwidth_to_fit() {
     let base = ["pcf", "--sampler", "jitter", "-n", "1024", "--sets", "1"];
     for (range, note) in [
         ("0.5", "note: --bandwidth 0.05 r_max (not 0.15)"),
+        ("0.7", "note: --bandwidth 0.07 r_max (not 0.15)"),
         ("0.001", "note: --bandwidth 0.001 r_max (not 0.15)"),
     ] {
         let out = crate::common::varspec_ok(&[&base[..], &["--range", range]].concat());

@@ -134,10 +134,16 @@ impl DrawArgs {
     }
 }
 
-/// A path for a file written in one format: a name ending in another
-/// extension (`--png s.csv`, `--pfm out.exr`) is refused rather than filled
-/// with `what`'s bytes; no extension (`/dev/null`) is fine.
-fn path_for(text: &str, ext: &str, what: &str) -> Result<std::path::PathBuf, String> {
+/// A path for a file written in one format: a name whose extension says
+/// another is refused rather than filled with `what`'s bytes (`--png
+/// s.csv`, `--pfm out.exr`); no extension (`/dev/null`) is fine. `refused`
+/// says which extensions: every one but `ext`, or only those listed.
+fn path_for(
+    text: &str,
+    ext: &str,
+    what: &str,
+    refused: Option<&[&str]>,
+) -> Result<std::path::PathBuf, String> {
     if text.is_empty() {
         return Err(format!(
             "an empty file name: name the {what} file, e.g. out.{ext}"
@@ -145,9 +151,13 @@ fn path_for(text: &str, ext: &str, what: &str) -> Result<std::path::PathBuf, Str
     }
     let path = std::path::PathBuf::from(text);
     match path.extension().map(|e| e.to_string_lossy().to_lowercase()) {
-        Some(given) if given != ext => Err(format!(
-            "`{text}`: a {what} is written here (not .{given}); name the file .{ext}"
-        )),
+        Some(given)
+            if given != ext && refused.is_none_or(|list| list.contains(&given.as_str())) =>
+        {
+            Err(format!(
+                "`{text}`: a {what} is written here (not .{given}); name the file .{ext}"
+            ))
+        }
         _ => Ok(path),
     }
 }
@@ -157,7 +167,7 @@ fn path_for(text: &str, ext: &str, what: &str) -> Result<std::path::PathBuf, Str
 /// # Errors
 /// A sentence naming the path.
 pub fn png_path(text: &str) -> Result<std::path::PathBuf, String> {
-    path_for(text, "png", "PNG picture")
+    path_for(text, "png", "PNG picture", None)
 }
 
 /// A float image's path, written as PFM ([`path_for`]; `--pfm out.exr`
@@ -166,7 +176,7 @@ pub fn png_path(text: &str) -> Result<std::path::PathBuf, String> {
 /// # Errors
 /// A sentence naming the path.
 pub fn pfm_path(text: &str) -> Result<std::path::PathBuf, String> {
-    path_for(text, "pfm", "PFM float image")
+    path_for(text, "pfm", "PFM float image", None)
 }
 
 /// A NumPy array's path, written as .npy ([`path_for`]).
@@ -174,12 +184,13 @@ pub fn pfm_path(text: &str) -> Result<std::path::PathBuf, String> {
 /// # Errors
 /// A sentence naming the path.
 pub fn npy_path(text: &str) -> Result<std::path::PathBuf, String> {
-    path_for(text, "npy", "NumPy .npy array")
+    path_for(text, "npy", "NumPy .npy array", None)
 }
 
-/// A point-set file's path: CSV, or NumPy .npy when the name ends in .npy.
-/// A name whose extension says another format (`t.npz`, `t.png`, `t.json`)
-/// would get CSV text under it, and is refused.
+/// A point-set file's path: CSV, or NumPy .npy when the name ends in .npy
+/// (any other name is CSV: `.txt`, `.dat`). A name whose extension says
+/// another format (`t.npz`, `t.png`, `t.json`) would get CSV text under it,
+/// and is refused.
 ///
 /// # Errors
 /// A sentence naming the path.
@@ -187,17 +198,12 @@ pub fn point_file_path(text: &str) -> Result<std::path::PathBuf, String> {
     const OTHER_FORMATS: [&str; 10] = [
         "npz", "png", "jpg", "jpeg", "pfm", "exr", "json", "pdf", "svg", "h",
     ];
-    if text.is_empty() {
-        return Err("an empty file name: name the point-set file, e.g. points.csv".into());
-    }
-    let path = std::path::PathBuf::from(text);
-    match path.extension().map(|e| e.to_string_lossy().to_lowercase()) {
-        Some(ext) if OTHER_FORMATS.contains(&ext.as_str()) => Err(format!(
-            "`{text}`: point sets are written as CSV (or UTK text with sample --format utk), or \
-             as NumPy .npy when the name ends in .npy, not as .{ext}; name the file .csv or .npy"
-        )),
-        _ => Ok(path),
-    }
+    path_for(
+        text,
+        "csv",
+        "point-set CSV (or NumPy .npy, by the name)",
+        Some(&OTHER_FORMATS),
+    )
 }
 
 /// Refuses an output folder `path` (named by `option`) that is an existing

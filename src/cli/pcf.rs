@@ -72,8 +72,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let mut bandwidth = a.bandwidth.unwrap_or_else(|| {
         let fitted = (range / MIN_RANGE_IN_BANDWIDTHS).clamp(1e-3, DEFAULT_BANDWIDTH);
         if fitted < DEFAULT_BANDWIDTH {
+            // To 4 decimals, without float noise (0.06999999999999999).
+            let shown = (fitted * 1e4).round() / 1e4;
             eprintln!(
-                "note: --bandwidth {fitted} r_max (not {DEFAULT_BANDWIDTH}): a tenth of --range \
+                "note: --bandwidth {shown} r_max (not {DEFAULT_BANDWIDTH}): a tenth of --range \
                  {range}, at least 0.001"
             );
         }

@@ -3,7 +3,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use clap::ValueEnum;
 
 use super::{args, progress};
@@ -15,7 +15,7 @@ use varspec::registry::SAMPLERS;
 use varspec::samplers;
 
 /// Point-set file formats.
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Format {
     /// CSV with a `[set,]x0,x1,...` header.
     Csv,
@@ -92,6 +92,22 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let name = registry::label(&name, &a.params)?;
     args::note_caveat(sampler.as_ref());
     let format = Format::resolve(a.format, a.output.as_deref());
+    // --format against the name: UTK text in `u.npy`, or .npy bytes in
+    // `u.csv`, would misstate the file (a name without an extension says
+    // nothing).
+    if let Some(path) = &a.output
+        && let Some(ext) = path.extension()
+        && ext.eq_ignore_ascii_case("npy") != (format == Format::Npy)
+    {
+        bail!(
+            "--format {} with -o {}: the name says another format; name the file .npy for npy, \
+             anything else (.csv, .txt) for csv and utk",
+            format
+                .to_possible_value()
+                .map_or("?".into(), |v| v.get_name().to_string()),
+            path.display()
+        );
+    }
     note_large_output(format, sampler.points_per_set(), sampler.dim(), a.sets);
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
     let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|_| bar.inc(1))?;

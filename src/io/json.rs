@@ -39,7 +39,17 @@ pub fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, String> {
         // message's line and column say where.
         let full = e.path().to_string();
         let path = full.trim_end_matches('?').trim_end_matches('.');
-        if let Some(located) = field_in_tagged_object::<T>(text, path) {
+        let wrong_value = {
+            let inner = e.inner().to_string();
+            inner.starts_with("invalid type") || inner.starts_with("invalid value")
+        };
+        // Hand-written files only: the search parses the text again and
+        // deserializes it once per key (a large table shard need not).
+        if wrong_value
+            && !path.is_empty()
+            && text.len() <= LOCATE_LIMIT
+            && let Some(located) = field_in_tagged_object::<T>(text, path)
+        {
             return located;
         }
         let message = plain_message(e.inner(), text);
@@ -52,6 +62,10 @@ pub fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, String> {
     de.end().map_err(|e| e.to_string())?;
     Ok(value)
 }
+
+/// The largest text whose wrong-typed field [`field_in_tagged_object`]
+/// looks for (experiment and scene files are kilobytes).
+const LOCATE_LIMIT: usize = 1 << 20;
 
 /// The field of a wrong type inside an internally tagged enum's object
 /// (`{"figure": "scene-samplers", "spp": [16]}`), whose fields serde reads
@@ -72,41 +86,39 @@ fn field_in_tagged_object<T: DeserializeOwned>(text: &str, path: &str) -> Option
             .map(|e| (e.path().to_string(), e.inner().to_string()))
     };
     let (original_path, original) = error_of(root.clone())?;
-    if original_path.trim_end_matches(['?', '.']) != path
-        || !(original.starts_with("invalid type") || original.starts_with("invalid value"))
-    {
+    if original_path.trim_end_matches(['?', '.']) != path {
         return None;
     }
     let pointer = json_pointer(path)?;
-    let keys: Vec<String> = root
-        .pointer(&pointer)?
-        .as_object()?
-        .keys()
-        .cloned()
-        .collect();
     let object = root.pointer(&pointer)?.as_object()?;
-    keys.into_iter()
-        .filter(|key| original.contains(&unexpected(&object[key.as_str()])))
-        .find_map(|key| {
+    object
+        .iter()
+        .filter(|(_, value)| {
+            unexpected(value)
+                .iter()
+                .any(|words| original.contains(words.as_str()))
+        })
+        .find_map(|(key, _)| {
             let mut trial = root.clone();
-            trial.pointer_mut(&pointer)?.as_object_mut()?.remove(&key);
+            trial.pointer_mut(&pointer)?.as_object_mut()?.remove(key);
             (error_of(trial).map(|e| e.1) != Some(original.clone()))
                 .then(|| format!("{path}.{key}: {original}"))
         })
 }
 
-/// How serde's "invalid type" and "invalid value" errors describe a JSON
-/// value (serde::de::Unexpected's wording).
-fn unexpected(value: &serde_json::Value) -> String {
+/// How serde's "invalid type" and "invalid value" errors may describe a
+/// JSON value (serde::de::Unexpected's wording; null reads `null` from
+/// serde_json and `unit value` from a buffered tagged enum).
+fn unexpected(value: &serde_json::Value) -> Vec<String> {
     use serde_json::Value;
     match value {
-        Value::Null => "unit value".into(),
-        Value::Bool(b) => format!("boolean `{b}`"),
-        Value::Number(n) if n.is_f64() => format!("floating point `{n}`"),
-        Value::Number(n) => format!("integer `{n}`"),
-        Value::String(s) => format!("string {s:?}"),
-        Value::Array(_) => "sequence".into(),
-        Value::Object(_) => "map".into(),
+        Value::Null => vec!["null".into(), "unit value".into()],
+        Value::Bool(b) => vec![format!("boolean `{b}`")],
+        Value::Number(n) if n.is_f64() => vec![format!("floating point `{n}`")],
+        Value::Number(n) => vec![format!("integer `{n}`")],
+        Value::String(s) => vec![format!("string {s:?}")],
+        Value::Array(_) => vec!["sequence".into()],
+        Value::Object(_) => vec!["map".into()],
     }
 }
 

@@ -534,17 +534,14 @@ fn frame_for_square_cells(map: &HeatMap, aspect: f64) -> std::io::Result<(u32, u
     Ok((w, h))
 }
 
-/// A colour range that spans something: a field constant to a thousandth
-/// of its size (every pixel's shear 0; a row of equal variances that
-/// differ by rounding) gets its middle ± 1 instead of a bar whose ticks
-/// all read the same (eleven ticks of −1.9488).
+/// A colour range that spans something: an empty one (a constant field:
+/// every pixel's shear 0) gets v ± 1 instead of a bar whose ticks all read
+/// the same. A range given is otherwise kept, however narrow.
 fn colour_span((lo, hi): (f64, f64)) -> (f64, f64) {
-    let flat = 1e-3 * lo.abs().max(hi.abs()).max(1.0);
-    if hi - lo > flat {
+    if hi > lo {
         (lo, hi)
-    } else if lo.is_finite() && hi.is_finite() {
-        let mid = 0.5 * (lo + hi);
-        (mid - 1.0, mid + 1.0)
+    } else if lo.is_finite() {
+        (lo - 1.0, lo + 1.0)
     } else {
         (-1.0, 1.0)
     }
@@ -719,9 +716,8 @@ mod tests {
         assert_eq!(tick_number(0.125), "0.125");
         assert_eq!(colour_span((0.0, 0.0)), (-1.0, 1.0));
         assert_eq!(colour_span((-3.0, -2.0)), (-3.0, -2.0));
-        // Equal to rounding (a row of equal variances): the middle ± 1.
-        let (lo, hi) = colour_span((-1.948_847_3, -1.948_847_1));
-        assert!((lo + 2.948_847_2).abs() < 1e-12 && (hi + 0.948_847_2).abs() < 1e-12);
+        // A narrow range given is kept (--variance-range -3,-2.998).
+        assert_eq!(colour_span((-3.0, -2.998)), (-3.0, -2.998));
     }
 
     #[test]

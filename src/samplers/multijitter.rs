@@ -48,11 +48,7 @@ impl MultiJitter {
     pub(crate) fn grid(c: &Config) -> Result<(usize, usize), SamplerError> {
         let n = c.n;
         let m = match c.param("m") {
-            "auto" => (1..=n)
-                .take_while(|m| m * m <= n)
-                .filter(|m| n % m == 0)
-                .last()
-                .unwrap_or(1),
+            "auto" => squarest_columns(n),
             text => match text.parse::<usize>() {
                 Ok(m) if m >= 1 && n % m == 0 => m,
                 _ => return Err(c.bad_param("m", format!("`auto` or a divisor of N = {n}"))),
@@ -97,6 +93,15 @@ impl MultiJitter {
     }
 }
 
+/// The column count `m = auto` picks: the divisor of `n` nearest below √n.
+fn squarest_columns(n: usize) -> usize {
+    (1..=n)
+        .take_while(|m| m * m <= n)
+        .filter(|m| n % m == 0)
+        .last()
+        .unwrap_or(1)
+}
+
 pub(crate) fn multijitter_from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> {
     let (m, n) = MultiJitter::grid(c)?;
     Ok(Box::new(MultiJitter::new(m, n, false)?))
@@ -138,12 +143,7 @@ impl Sampler for MultiJitter {
             } else {
                 "multijitter"
             };
-            // The grid `m = auto` picks: the divisor of N nearest below √N.
-            let nearest = (1..=n)
-                .take_while(|d| d * d <= n)
-                .filter(|d| n % d == 0)
-                .last()
-                .unwrap_or(1);
+            let nearest = squarest_columns(n);
             if 4 * nearest < n / nearest {
                 let square = (n as f64).sqrt().round() as usize;
                 format!(

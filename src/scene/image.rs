@@ -147,7 +147,9 @@ impl GreyImage {
                                 "a colour PFM whose channels differ at pixel ({x}, {}): {:?}; \
                                  the renderer's images are grey (give one channel, or equal ones)",
                                 height - 1 - r,
-                                rgb
+                                // As stored (f32), not widened: 0.3, not
+                                // 0.30000001192092896.
+                                rgb.iter().map(|&v| v as f32).collect::<Vec<_>>()
                             )))
                         }
                     })
@@ -220,7 +222,16 @@ impl GreyImage {
             finite.sort_by(f64::total_cmp);
             let at = |q: f64| finite[((q * finite.len() as f64) as usize).min(finite.len() - 1)];
             let hi = at(0.999);
-            (at(0.01).max(hi - 6.0), hi)
+            let lo = at(0.01).max(hi - 6.0);
+            // Variances equal to a thousandth of a decade (a row of equal
+            // pixels, differing by rounding) read as one value: the bar
+            // spans a decade each side of it, not eleven equal ticks.
+            if hi - lo < 1e-3 {
+                let mid = 0.5 * (lo + hi);
+                (mid - 1.0, mid + 1.0)
+            } else {
+                (lo, hi)
+            }
         });
         // Every pixel grey: the bar's range maps nothing, and the title says
         // why.
@@ -239,8 +250,6 @@ impl GreyImage {
                 x_label: "pixel x".into(),
                 y_label: "pixel y (from the top)".into(),
                 bar_label: "log10 variance (grey: 0)".into(),
-                // A constant field (lo = hi) is drawn at the middle of v ± 1
-                // by the heat map (a 1e-9 span gave eleven equal ticks).
                 colour_range: (lo, hi),
             },
             path,
@@ -308,7 +317,7 @@ mod tests {
         );
         let e = read(&colour([[0.25, 0.25, 0.3], [1.5; 3]])).unwrap_err();
         assert!(
-            e.contains("a colour PFM whose channels differ at pixel (0, 1): [0.25, 0.25, 0.30000001192092896]"),
+            e.contains("a colour PFM whose channels differ at pixel (0, 1): [0.25, 0.25, 0.3]"),
             "{e}"
         );
         let e = read(b"P6\n1 1\n-1.0\n\0\0\0\0").unwrap_err();
