@@ -238,6 +238,8 @@ fn double_wedges_are_told_from_single_layers() {
         // A steep layer leaves the box early; with most of the energy it
         // is still the first line (review: it was reported second).
         "layers:shape=box,size=0.3,c1=4,c2=0.5,mix=0.3",
+        // ... and a steep weak layer beyond the fit's range (read as 0.645).
+        "layers:shape=box,size=0.3,c1=4,c2=0.5,mix=0.7",
     ] {
         let f = integrands::parse(spec).unwrap();
         let start = spectral_start(f.as_ref(), 64, 2.0);

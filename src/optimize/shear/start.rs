@@ -53,6 +53,8 @@ const MIN_SEPARATION: f64 = 0.15;
 /// Slope resolution of the line scan (finer slopes come from Brent's
 /// method between scan points).
 const SLOPE_STEP: f64 = 0.005;
+/// Step of the first scan for a double wedge's lines over every slope.
+const COARSE_SLOPE_STEP: f64 = 0.04;
 /// The steepest slope the analysis scans: the defocus integrand's |c| ≤ 16,
 /// and at 16 a line leaves the box |k|∞ ≤ 64 by k_x = 4. (A vertical
 /// principal direction, a symmetric double wedge's, would otherwise widen
@@ -288,21 +290,24 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
     // the one holding best the columns where it lies apart from the first;
     // the one whose band holds more energy (the strongest layer) is
     // reported first.
+    // The lines are sought over every slope the analysis reads (±16), not
+    // only the range the fit scanned: a second layer steeper than the
+    // first's range (c = 4 beside a strong 0.5) read as 0.645.
+    let best_hold = |other: Option<f64>| {
+        most_held(&|s| {
+            if other.is_some_and(|o| (s - o).abs() < MIN_SEPARATION) {
+                f64::NEG_INFINITY
+            } else {
+                hold(s, other)
+            }
+        })
+    };
     let s1 = if one_line_misfit > DOUBLE_WEDGE_MISFIT {
-        slopes
-            .iter()
-            .map(|&s| (s, hold(s, None)))
-            .fold((fitted, 0.0), |acc, c| if c.1 > acc.1 { c } else { acc })
-            .0
+        best_hold(None)
     } else {
         fitted
     };
-    let s2 = slopes
-        .iter()
-        .filter(|&&s| (s - s1).abs() >= MIN_SEPARATION)
-        .map(|&s| (s, hold(s, Some(s1))))
-        .fold((0.0, 0.0), |acc, c| if c.1 > acc.1 { c } else { acc })
-        .0;
+    let s2 = best_hold(Some(s1));
     let (s1, s2) = if one_line_misfit > DOUBLE_WEDGE_MISFIT && share(s2, None) > share(s1, None) {
         (s2, s1)
     } else {
@@ -322,6 +327,30 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
         second_line_share,
         one_line_misfit,
     }
+}
+
+/// The slope in [−[`MAX_SLOPE`], [`MAX_SLOPE`]] of the largest `score`:
+/// a scan at [`COARSE_SLOPE_STEP`], then one at [`SLOPE_STEP`] within a
+/// coarse step of the best (a band's hold falls off over ~1/|k₁| of slope
+/// from its layer's, so the coarse scan lands on the peak's flank).
+fn most_held(score: &dyn Fn(f64) -> f64) -> f64 {
+    let best = |slopes: &mut dyn Iterator<Item = f64>| {
+        slopes
+            .map(|s| (s, score(s)))
+            .fold(
+                (0.0, f64::NEG_INFINITY),
+                |acc, c| if c.1 > acc.1 { c } else { acc },
+            )
+            .0
+    };
+    let coarse = (MAX_SLOPE / COARSE_SLOPE_STEP).round() as i64;
+    let centre = best(&mut (-coarse..=coarse).map(|i| i as f64 * COARSE_SLOPE_STEP));
+    let fine = (COARSE_SLOPE_STEP / SLOPE_STEP).round() as i64;
+    best(
+        &mut (-fine..=fine)
+            .map(|i| ((centre / SLOPE_STEP).round() + i as f64) * SLOPE_STEP)
+            .filter(|s| s.abs() <= MAX_SLOPE),
+    )
 }
 
 /// The misfit as an argmin cost of the slope.
