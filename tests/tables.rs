@@ -18,6 +18,17 @@ fn dir(tag: &str) -> PathBuf {
     d
 }
 
+/// `varspec tables --sampler cmj -n 4 --sets 1` with `args` after.
+fn one_cmj_set(args: &[&str]) -> String {
+    varspec(
+        &[
+            &["tables", "--sampler", "cmj", "-n", "4", "--sets", "1"],
+            args,
+        ]
+        .concat(),
+    )
+}
+
 /// Runs `varspec args`, asserts success and returns its standard error.
 fn varspec(args: &[&str]) -> String {
     let out = Command::new(env!("CARGO_BIN_EXE_varspec"))
@@ -615,19 +626,7 @@ fn a_c_header_is_named_by_the_file_name_up_to_its_last_dot() {
         ("int.h", "table_int"),
     ] {
         let out = d.join(file);
-        varspec(&[
-            "tables",
-            "--sampler",
-            "cmj",
-            "-n",
-            "4",
-            "--sets",
-            "1",
-            "--format",
-            "c-header",
-            "-o",
-            out.to_str().unwrap(),
-        ]);
+        one_cmj_set(&["--format", "c-header", "-o", out.to_str().unwrap()]);
         let header = std::fs::read_to_string(&out).unwrap();
         assert!(
             header.contains(&format!("static const float {id}[1][4][2]")),
@@ -901,21 +900,7 @@ fn a_table_converted_from_a_table_keeps_its_provenance() {
             "the `metadata` field of",
         ),
     ] {
-        varspec(&[
-            "tables",
-            "--sampler",
-            "cmj",
-            "-n",
-            "4",
-            "--sets",
-            "1",
-            "--seed",
-            "3",
-            "--format",
-            format,
-            "-o",
-            &t(name),
-        ]);
+        one_cmj_set(&["--seed", "3", "--format", format, "-o", &t(name)]);
         // The first value after the metadata, 0.0876…, becomes 0.50876….
         let mut text = std::fs::read_to_string(d.join(name)).unwrap();
         let array = text.find(values).unwrap();

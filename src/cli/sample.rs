@@ -28,11 +28,26 @@ pub enum Format {
 impl Format {
     /// The format asked for, else the one the output's extension names
     /// (`.npy`), else CSV.
-    fn resolve(asked: Option<Format>, output: Option<&Path>) -> Format {
-        asked.unwrap_or(match output.and_then(Path::extension) {
-            Some(ext) if ext.eq_ignore_ascii_case("npy") => Format::Npy,
-            _ => Format::Csv,
-        })
+    ///
+    /// # Errors
+    /// A format asked for against the output's name (UTK text in `u.npy`,
+    /// or .npy bytes in `u.csv`, would misstate the file; a name without
+    /// an extension says nothing).
+    fn resolve(asked: Option<Format>, output: Option<&Path>) -> anyhow::Result<Format> {
+        let ext = output.and_then(Path::extension);
+        let npy_name = ext.is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+        match asked {
+            None if npy_name => Ok(Format::Npy),
+            None => Ok(Format::Csv),
+            Some(f) if ext.is_none() || npy_name == (f == Format::Npy) => Ok(f),
+            Some(f) => bail!(
+                "--format {} with -o {}: the name says another format; name the file .npy for \
+                 npy, anything else (.csv, .txt) for csv and utk",
+                f.to_possible_value()
+                    .map_or("?".into(), |v| v.get_name().to_string()),
+                output.map_or(String::new(), |p| p.display().to_string())
+            ),
+        }
     }
 
     fn write(self, out: &mut dyn Write, sets: &[PointSet]) -> std::io::Result<()> {
@@ -91,23 +106,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let sampler = registry::build(&name, n, a.dim, &a.params)?;
     let name = registry::label(&name, &a.params)?;
     args::note_caveat(sampler.as_ref());
-    let format = Format::resolve(a.format, a.output.as_deref());
-    // --format against the name: UTK text in `u.npy`, or .npy bytes in
-    // `u.csv`, would misstate the file (a name without an extension says
-    // nothing).
-    if let Some(path) = &a.output
-        && let Some(ext) = path.extension()
-        && ext.eq_ignore_ascii_case("npy") != (format == Format::Npy)
-    {
-        bail!(
-            "--format {} with -o {}: the name says another format; name the file .npy for npy, \
-             anything else (.csv, .txt) for csv and utk",
-            format
-                .to_possible_value()
-                .map_or("?".into(), |v| v.get_name().to_string()),
-            path.display()
-        );
-    }
+    let format = Format::resolve(a.format, a.output.as_deref())?;
     note_large_output(format, sampler.points_per_set(), sampler.dim(), a.sets);
     let bar = progress::bar(a.sets as u64, &format!("{name} N={n}"));
     let sets = samplers::generate_sets(sampler.as_ref(), a.seed, a.sets, &|_| bar.inc(1))?;

@@ -287,12 +287,12 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
     };
     // One line: the fitted slope. A double wedge: the fit lies between the
     // layers, so one line is the slope holding the columns best, the other
-    // the one holding best the columns where it lies apart from the first;
-    // the one whose band holds more energy (the strongest layer) is
-    // reported first.
-    // The lines are sought over every slope the analysis reads (±16), not
-    // only the range the fit scanned: a second layer steeper than the
-    // first's range (c = 4 beside a strong 0.5) read as 0.645.
+    // the one holding best the columns where it lies apart from the first,
+    // each sought over every slope the analysis reads (±16), not only the
+    // range the fit scanned (a second layer at c = 4 beside a strong 0.5
+    // read as 0.645); the one whose band holds more energy (the strongest
+    // layer) is reported first.
+    let double_wedge = one_line_misfit > DOUBLE_WEDGE_MISFIT;
     let best_hold = |other: Option<f64>| {
         most_held(&|s| {
             if other.is_some_and(|o| (s - o).abs() < MIN_SEPARATION) {
@@ -302,23 +302,20 @@ fn directions(grid: &[f64], half: i64, range: f64) -> PlaneDirections {
             }
         })
     };
-    let s1 = if one_line_misfit > DOUBLE_WEDGE_MISFIT {
+    let s1 = if double_wedge {
         best_hold(None)
     } else {
         fitted
     };
     let s2 = best_hold(Some(s1));
-    let (s1, s2) = if one_line_misfit > DOUBLE_WEDGE_MISFIT && share(s2, None) > share(s1, None) {
-        (s2, s1)
+    let (share1, share2) = (share(s1, None), share(s2, None));
+    let (s1, s2, first_line_share) = if double_wedge && share2 > share1 {
+        (s2, s1, share2)
     } else {
-        (s1, s2)
+        (s1, s2, share1)
     };
-    let first_line_share = share(s1, None);
     let second_line_share = share(s2, Some(s1));
-    let mut lines = vec![s1];
-    if one_line_misfit > DOUBLE_WEDGE_MISFIT {
-        lines.push(s2);
-    }
+    let lines = if double_wedge { vec![s1, s2] } else { vec![s1] };
     PlaneDirections {
         principal,
         eigenvalue_ratio,
