@@ -23,7 +23,8 @@ pub struct Args {
     /// Integrand of the sampler comparison.
     #[arg(long, default_value = "disk:r=0.3")]
     integrand: String,
-    /// Defocus pixel of the shear search.
+    /// Light field of the shear search: a defocus pixel, or `layers:…` (two
+    /// depths, a double wedge).
     #[arg(long, default_value = "defocus:shape=disk,size=0.3,c=0.45")]
     pixel: String,
 }
@@ -53,7 +54,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map_or("?", |r| r.sampler.as_str());
     announce!(
         "wrote {} in {:.1} s: lowest variance on {} at N = {}: {best}; square design {:.2}x CMJ on half-planes; \
-         shear ({:.3}, {:.3}) for c = {}, {:.1}x lower",
+         shear ({:.3}, {:.3}) for c = {}, {:.2}x lower",
         a.output.join("index.html").display(),
         tour.seconds,
         tour.predict.integrand,

@@ -9,7 +9,15 @@ use serde_json::Value;
 
 use super::{Tour, TourError};
 
-const TEMPLATE: &str = include_str!("templates/tour.html");
+/// The page and the sections it includes, by template name.
+const TEMPLATES: [(&str, &str); 6] = [
+    ("tour.html", include_str!("templates/tour.html")),
+    ("predict.html", include_str!("templates/predict.html")),
+    ("square.html", include_str!("templates/square.html")),
+    ("shear.html", include_str!("templates/shear.html")),
+    ("scene.html", include_str!("templates/scene.html")),
+    ("speed.html", include_str!("templates/speed.html")),
+];
 
 fn fail<E: std::fmt::Display>(e: E) -> TourError {
     TourError::Step {
@@ -62,12 +70,51 @@ pub fn render_tour(tour: &Tour, folder: &Path) -> Result<(), TourError> {
         map.insert("threads".into(), Value::from(rayon::current_num_threads()));
         map.insert("seed".into(), Value::from(tour.options.seed));
     }
-    let mut env = minijinja::Environment::new();
-    env.add_template("tour.html", TEMPLATE).map_err(fail)?;
-    let html = env
-        .get_template("tour.html")
-        .and_then(|t| t.render(&context))
-        .map_err(fail)?;
+    let html = page("tour.html", &context)?;
     crate::io::write_atomic(&folder.join("index.html"), |w| w.write_all(html.as_bytes()))
         .map_err(fail)
+}
+
+/// Template `name` (the page, `tour.html`, or one section) filled with
+/// `context` (the tour's data, pictures embedded).
+fn page(name: &str, context: &Value) -> Result<String, TourError> {
+    let mut env = minijinja::Environment::new();
+    for (template, text) in TEMPLATES {
+        env.add_template(template, text).map_err(fail)?;
+    }
+    env.get_template(name)
+        .and_then(|t| t.render(context))
+        .map_err(fail)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The shear section alone, drawn for a light field with `analytic`
+    /// layer shears.
+    fn shear_page(analytic: &[[f64; 2]]) -> String {
+        let context = serde_json::json!({ "shear": {
+            "integrand": "light-field", "n": 256, "shear": [-0.15, -0.15],
+            "initial": [-0.12, -0.12], "initial_value": 8e-5, "analytic": analytic,
+            "unsheared": 8e-5, "optimum": 7.7e-5, "truncation_bound": 0.001,
+            "reduction": 1.04, "check_before": 8e-5, "check_before_low": 7e-5,
+            "check_before_high": 9e-5, "check_after": 7.6e-5, "check_after_low": 7e-5,
+            "check_after_high": 8e-5, "seconds": 1.0, "spectra": [], "commands": []
+        }});
+        page("shear.html", &context).unwrap()
+    }
+
+    #[test]
+    fn a_double_wedge_is_drawn_as_two_layers() {
+        let two = shear_page(&[[-0.5, -0.5], [0.2, 0.2]]);
+        assert!(two.contains("2 sheared planes"), "{two}");
+        assert!(two.contains("double wedge"));
+        assert!(two.contains("analytic −c, layer 1</td><td>(-0.500, -0.500)"));
+        assert!(two.contains("analytic −c, layer 2</td><td>(0.200, 0.200)"));
+        let one = shear_page(&[[-0.45, -0.45]]);
+        assert!(one.contains("the sheared plane"), "{one}");
+        assert!(!one.contains("double wedge") && !one.contains("layer 1"));
+        assert!(one.contains("analytic −c</td><td>(-0.450, -0.450)"));
+    }
 }
