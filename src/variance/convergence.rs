@@ -154,6 +154,10 @@ pub fn fit_slope(ns: &[f64], vars: &[f64]) -> Result<SlopeFit, SlopeError> {
 /// miss by sub-leading terms (results/rates). CMJ on smooth integrands has
 /// none: its correlated strata are not jitter's independent ones, and it
 /// measures N^−3.06 on a Gaussian (results/rates), beyond jitter's N^−2.
+/// Shifted lattices (`uniform-jitter`, `regular`, `lattice`) have none:
+/// their rate depends on the integrand's shape, not its class (N^−3/2 on
+/// average over a disk's radii, Kendall 1948; N^−1 on an axis-aligned
+/// edge; results/rates).
 pub fn theoretical_rate(sampler: &str, class: IntegrandClass, dim: usize) -> Option<f64> {
     let d = dim as f64;
     let jitter = if class.smooth {
