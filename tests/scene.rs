@@ -529,12 +529,38 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
     let dir = std::env::temp_dir().join(format!("varspec-badobj-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let files = [
-        ("far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "vertex"),
+        // tobj's errors do not say where; the message names the line.
+        (
+            "far.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+            "far.obj line 4: face vertex index out of bounds: `f 1 2 9`",
+        ),
+        (
+            "before.obj",
+            "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\nf 1 2 3\n",
+            "before.obj line 3: face vertex index out of bounds",
+        ),
+        (
+            "normal.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1//1 2//1 3//2\n",
+            "normal.obj line 6: face normal index out of bounds",
+        ),
+        (
+            "word.obj",
+            "v 0 0 0\nv 1 0 0\n\nv 0 1 x\nf 1 2 3\n",
+            "word.obj line 4: position parse error: `v 0 1 x`",
+        ),
+        (
+            "face.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1/1/1/1 2 3\n",
+            "face.obj line 5: face parse error",
+        ),
         ("empty.obj", "v 0 0 0\nv 1 0 0\n", "at least one face"),
         (
             "nan.obj",
-            "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
-            "finite",
+            // The line, where the value stands as written.
+            "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n",
+            "nan.obj line 2: `v nan 0 0`)",
         ),
         (
             "huge.obj",

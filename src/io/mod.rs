@@ -42,3 +42,14 @@ pub fn write_point_file(
         }
     })
 }
+
+/// At most 60 characters of `text`, escaped, for an error message that
+/// quotes a line of a file.
+pub fn quote(text: &str) -> String {
+    let short: String = text.chars().take(60).collect();
+    let mut out = short.escape_debug().to_string();
+    if text.chars().count() > 60 {
+        out.push('…');
+    }
+    out
+}

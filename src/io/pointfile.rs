@@ -26,6 +26,7 @@ use std::path::{Path, PathBuf};
 use super::bounded::BOM;
 use super::csv_rows::csv_io_error;
 use super::npy;
+use super::quote;
 use super::tables::{self, TableMetadata};
 use crate::points::PointSet;
 
@@ -653,16 +654,6 @@ impl Parser<'_> {
         }
         Ok(self.sets)
     }
-}
-
-/// At most 60 characters of `text`, escaped, for an error message.
-fn quote(text: &str) -> String {
-    let short: String = text.chars().take(60).collect();
-    let mut out = short.escape_debug().to_string();
-    if text.chars().count() > 60 {
-        out.push('…');
-    }
-    out
 }
 
 fn coordinate(text: &str, field: usize) -> Result<f64, LineProblem> {

@@ -102,19 +102,44 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         ignore_lines: true,
         ..Default::default()
     };
-    let (models, _materials) = tobj::load_obj(path, &options)
-        .map_err(|e| format!("a Wavefront OBJ file ({}: {e})", path.display()))?;
+    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| {
+        // tobj's errors do not say where; the line is found again in the text.
+        let text = std::fs::read(path).unwrap_or_default();
+        let text = String::from_utf8_lossy(&text);
+        match obj_error_line(&text, &e) {
+            Some((number, line)) => format!(
+                "a Wavefront OBJ file ({} line {number}: {e}: `{}`)",
+                path.display(),
+                crate::io::quote(line)
+            ),
+            None => format!("a Wavefront OBJ file ({}: {e})", path.display()),
+        }
+    })?;
     let mut triangles = Vec::new();
     for model in &models {
         let positions = &model.mesh.positions;
-        if let Some(bad) = positions
-            .iter()
-            .find(|v| !v.is_finite() || f64::from(v.abs()) > MAX_LENGTH)
-        {
-            return Err(format!(
-                "finite vertex positions of magnitude at most {MAX_LENGTH:e} (model `{}` has {bad})",
-                model.name
-            ));
+        let out_of_range = |v: f32| !v.is_finite() || f64::from(v.abs()) > MAX_LENGTH;
+        if let Some(bad) = positions.iter().copied().find(|&v| out_of_range(v)) {
+            let expected = format!("finite vertex positions of magnitude at most {MAX_LENGTH:e}");
+            // The line, where the value stands as written (a `w` divides it).
+            let text = std::fs::read(path).unwrap_or_default();
+            let text = String::from_utf8_lossy(&text);
+            let line = text.lines().enumerate().find(|(_, l)| {
+                let mut words = l.split_whitespace();
+                words.next() == Some("v")
+                    && words
+                        .take(3)
+                        .any(|w| w.parse::<f32>().is_ok_and(out_of_range))
+            });
+            return Err(match line {
+                Some((number, line)) => format!(
+                    "{expected} ({} line {}: `{}`)",
+                    path.display(),
+                    number + 1,
+                    crate::io::quote(line)
+                ),
+                None => format!("{expected} (model `{}` has {bad})", model.name),
+            });
         }
         let vertex = |i: u32| {
             let at = 3 * i as usize;
@@ -151,4 +176,83 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         ));
     }
     Ok(triangles)
+}
+
+/// The first line of an OBJ text that tobj's `error` is about (1-based, with
+/// its text), for the errors one line causes: a position (`v`), texture
+/// coordinate (`vt`) or normal (`vn`) that does not parse, a face (`f`, `l`)
+/// that does not, or a face index past the vertices, coordinates or normals
+/// of the file (tobj checks a relative index against those before it).
+/// `None` for other errors, or where the text shows none.
+fn obj_error_line<'a>(text: &'a str, error: &tobj::LoadError) -> Option<(usize, &'a str)> {
+    use tobj::LoadError as E;
+    let floats = |words: &[&str], n: usize| {
+        words.len() >= n && words[..n].iter().all(|w| w.parse::<f32>().is_ok())
+    };
+    // The slots of `v/vt/vn`, each an index or empty; None if it is not one.
+    let slots = |word: &str| -> Option<Vec<Option<isize>>> {
+        let parts: Vec<&str> = word.split('/').collect();
+        if parts.len() > 3 {
+            return None;
+        }
+        parts
+            .iter()
+            .map(|p| {
+                (!p.is_empty())
+                    .then(|| p.parse::<isize>().ok())
+                    .map_or(Some(None), |i| i.map(Some))
+            })
+            .collect()
+    };
+    let slot = match error {
+        E::FaceVertexOutOfBounds => Some(0),
+        E::FaceTexCoordOutOfBounds => Some(1),
+        E::FaceNormalOutOfBounds => Some(2),
+        _ => None,
+    };
+    let keys = ["v", "vt", "vn"];
+    let total = |key: &str| {
+        text.lines()
+            .filter(|l| l.split_whitespace().next() == Some(key))
+            .count()
+    };
+    let totals = keys.map(total);
+    let mut before = [0usize; 3];
+    for (number, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let key = words.next();
+        let words: Vec<&str> = words.collect();
+        let bad = match (key, error) {
+            (Some("v"), E::PositionParseError) => {
+                !floats(&words, 3) || (words.len() == 4 && words[3].parse::<f32>().is_err())
+            }
+            (Some("v"), E::ScalingByZeroError) => {
+                words.len() == 4 && words[3].parse::<f32>() == Ok(0.0)
+            }
+            (Some("v"), E::ColorParseError) => words.len() == 5 || words.len() > 6,
+            (Some("vt"), E::TexcoordParseError) => !floats(&words, 2),
+            (Some("vn"), E::NormalParseError) => !floats(&words, 3),
+            (Some("f" | "l"), E::FaceParseError) => words.iter().any(|w| slots(w).is_none()),
+            (Some("f"), _) => slot.is_some_and(|k| {
+                // tobj checks texture coordinates and normals only when the
+                // file has some.
+                (k == 0 || totals[k] > 0)
+                    && words.iter().filter_map(|w| slots(w)).any(|s| {
+                        s.get(k).copied().flatten().is_some_and(|i| {
+                            i == 0
+                                || (i > 0 && i.unsigned_abs() > totals[k])
+                                || (i < 0 && i.unsigned_abs() > before[k])
+                        })
+                    })
+            }),
+            _ => false,
+        };
+        if bad {
+            return Some((number + 1, line));
+        }
+        if let Some(k) = keys.iter().position(|&k| Some(k) == key) {
+            before[k] += 1;
+        }
+    }
+    None
 }
