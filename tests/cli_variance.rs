@@ -810,6 +810,69 @@ fn converge_notes_a_theory_outside_the_interval_and_refuses_rounding_noise() {
     common::assert_fails(&args, "at or below the fourier form's rounding bound");
 }
 
+/// On 2D points a shift in (x, y) is the full shift: every predictor takes
+/// it and the estimator is named as such (it was labelled "the estimator of
+/// sheared 4D sets" and the Fourier and spatial forms refused it). A
+/// one-set file's missing standard error names what a file can do, and a 4D
+/// file under a 2D integrand is offered its XY plane too.
+#[test]
+fn two_dimensional_predictions_say_what_they_are() {
+    let dir = common::temp_dir("predict-2d");
+    let one = dir.join("j1.csv");
+    let four = dir.join("u4.csv");
+    common::varspec_ok(&[
+        "sample",
+        "jitter",
+        "-n",
+        "64",
+        "--sets",
+        "1",
+        "-o",
+        one.to_str().unwrap(),
+    ]);
+    common::varspec_ok(&[
+        "sample",
+        "umj",
+        "-n",
+        "64",
+        "--sets",
+        "2",
+        "-o",
+        four.to_str().unwrap(),
+    ]);
+    let base = [
+        "predict",
+        one.to_str().unwrap(),
+        "--integrand",
+        "disk:r=0.3",
+        "--method",
+        "spatial",
+    ];
+    let all = json(&[&base[..], &["--json"]].concat());
+    let xy = json(&[&base[..], &["--shift", "xy", "--json"]].concat());
+    assert_eq!(
+        xy["spatial"]["variance"], all["spatial"]["variance"],
+        "{xy}"
+    );
+    assert!(
+        xy["estimator"]
+            .as_str()
+            .unwrap()
+            .starts_with("shift-randomized"),
+        "{xy}"
+    );
+    let text = String::from_utf8(common::varspec_ok(&base).stdout).unwrap();
+    assert!(
+        text.contains("stderr unknown (one set: give a file of 2 or more sets)"),
+        "{text}"
+    );
+    common::assert_fails(
+        &["predict", four.to_str().unwrap(), "--integrand", "disk"],
+        "choose a projection with --dims (0,1 is XY, 2,3 is UV, 0,2 is XU, 1,3 is YV)",
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// Without a shift a file's sets are its realizations, each once: by
 /// default predict takes them all (it used to ask for 10,000 and refuse its
 /// own default), and more than the file holds is refused.

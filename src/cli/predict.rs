@@ -211,9 +211,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let sets = source.count();
     // A render averages f over each pixel's set as it is drawn: a pixel's
     // variance is that of the unshifted estimator.
-    let shift = a
-        .shift
-        .unwrap_or(if pixel { ShiftArg::None } else { ShiftArg::All });
+    // On a 2D integrand a shift in (x, y) is the shift in every dimension
+    // (it was labelled the estimator of sheared 4D sets, and only the
+    // empirical predictor took it).
+    let shift = match a.shift {
+        Some(ShiftArg::Xy) if f.dim() <= 2 => ShiftArg::All,
+        given => given.unwrap_or(if pixel { ShiftArg::None } else { ShiftArg::All }),
+    };
     // Unshifted, a file's sets count once each: the default realization
     // count becomes the file's set count.
     let realizations = match a.realizations {
@@ -536,9 +540,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                         "{extra} unknown ({})",
                         v["stderr_unknown"].as_str().unwrap_or_default()
                     ),
-                    None => format!(
-                        "{extra} unknown (one set: draw 2 or more with --sets, or give a file of 2 or more sets)"
+                    None if a.source.file().is_some() => format!(
+                        "{extra} unknown (one set: give a file of 2 or more sets)"
                     ),
+                    None => format!("{extra} unknown (one set: draw 2 or more with --sets)"),
                 },
             };
             let note = match rounding {

@@ -187,8 +187,8 @@ impl SourceArgs {
                     source.name()
                 );
             }
-            let example = if found == 4 {
-                " (0,2 is XU, 1,3 is YV)".to_string()
+            let example = if found == 4 && dim == 2 {
+                " (0,1 is XY, 2,3 is UV, 0,2 is XU, 1,3 is YV)".to_string()
             } else {
                 let first: Vec<String> = (0..dim).map(|i| i.to_string()).collect();
                 format!(", e.g. --dims {}", first.join(","))
