@@ -51,6 +51,29 @@ pub fn key_values(list: &str) -> Result<Vec<(&str, &str)>, ParamListError> {
         .collect()
 }
 
+/// The weights a term of a sum of losses may carry (`W*TERM`: a square
+/// design's `halfplanes+16*blue`, a 4D design's `xy:A;2*uv:B`). Weights are
+/// relative; far outside this range the weighted loss's squared gradients
+/// leave what f64 holds (`1e308*` turned the descent's positions into NaN,
+/// `1e160*` stopped it silently).
+pub const TERM_WEIGHTS: std::ops::RangeInclusive<f64> = 1e-6..=1e6;
+
+/// The weight `text` of a term `W*TERM`, a number within [`TERM_WEIGHTS`].
+///
+/// # Errors
+/// What the weight is not, for the caller's message.
+pub fn term_weight(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(w) if TERM_WEIGHTS.contains(&w) => Ok(w),
+        _ => Err(format!(
+            "weight `{}` is not a number in [{:e}, {:e}] (weights are relative)",
+            text.trim(),
+            TERM_WEIGHTS.start(),
+            TERM_WEIGHTS.end()
+        )),
+    }
+}
+
 /// A parameter value as a canonical spec writes it: the shortest decimal
 /// that reads back to the same f64, in exponent form (`1e-8`) where the
 /// plain form would spell out a run of zeros (below 1e-4 or from 1e15 on).

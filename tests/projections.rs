@@ -135,6 +135,13 @@ fn bad_projection_targets_are_refused() {
     assert!(parse_projections("layers:c1=0.5,c2=-0.2", 64).is_err());
     assert!(parse_projections("zz:family:disks", 64).is_err());
     assert!(parse_projections("-1*xy:family:disks", 64).is_err());
+    // Beyond 1e6 the weighted loss's squares overflowed: positions of NaN.
+    let huge = match parse_projections("1e308*xy:family:disks", 64) {
+        Ok(_) => panic!("a weight of 1e308 was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(huge.contains("not a number in [1e-6, 1e6]"), "{huge}");
+    assert!(parse_projections("1e6*xy:family:disks;uv:family:disks", 64).is_ok());
     assert!(parse_projections("xy:family:cubes", 64).is_err());
 }
 

@@ -286,6 +286,14 @@ fn targets_and_families_refuse_what_they_cannot_do() {
     assert!(parse_target(&format!("file:{}", list.display())).is_ok());
     assert!(parse_target("disks+boxes").is_ok());
     assert!(parse_target("halfplanes+-1*gaussians").is_err());
+    // Weights are relative and bounded: 1e308 turned positions into NaN.
+    for weight in ["1e308", "1e-320", "inf", "nan"] {
+        let e = parse_target(&format!("{weight}*halfplanes")).unwrap_err();
+        assert!(
+            e.to_string().contains("is not a number in [1e-6, 1e6]"),
+            "{e}"
+        );
+    }
     assert!(Family::parse("gaussians:vmin=2,vmax=1").is_err());
     assert!(
         Family::parse("gaussians:size=1")

@@ -105,13 +105,10 @@ pub fn parse_projections(spec: &str, n: usize) -> Result<Vec<ProjectionTerm>, Op
             )));
         }
         let (weight, part) = match part.split_once('*') {
-            Some((w, rest)) if w.trim().parse::<f64>().is_ok() => {
-                let w: f64 = w.trim().parse().expect("checked");
-                if !(w.is_finite() && w > 0.0) {
-                    return Err(fail(format!("weight {w} is not positive")));
-                }
-                (w, rest.trim())
-            }
+            Some((w, rest)) if w.trim().parse::<f64>().is_ok() => (
+                crate::spec_params::term_weight(w).map_err(fail)?,
+                rest.trim(),
+            ),
             _ => (1.0, part),
         };
         let planes = [

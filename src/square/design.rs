@@ -74,14 +74,7 @@ pub fn parse_target(spec: &str) -> Result<Vec<SquareTerm>, FamilyError> {
     let mut terms = Vec::new();
     for part in spec.split('+') {
         let (weight, family) = match part.split_once('*') {
-            Some((w, f)) => (
-                w.trim()
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|w| w.is_finite() && *w > 0.0)
-                    .ok_or_else(|| fail(format!("weight `{w}` is not a positive number")))?,
-                f,
-            ),
+            Some((w, f)) => (crate::spec_params::term_weight(w).map_err(fail)?, f),
             None => (1.0, part),
         };
         let kind = if family.trim() == "blue" {
