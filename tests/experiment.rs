@@ -93,6 +93,21 @@ fn shards_merged_equal_the_single_run_byte_for_byte() {
         "shard-1-of-3.json: it holds shard 0/3, whose file is shard-0-of-3.json",
     );
     assert_fails(&["experiment", f, "--shard", "3/3"], "0 <= i < n");
+    // A split's count is never allocated: merging one shard of 2^64 − 1
+    // panicked with a capacity overflow (stress probe).
+    let wide = dir.join("wide");
+    ok(&[
+        "experiment",
+        f,
+        "--shard",
+        "0/18446744073709551615",
+        "-o",
+        wide.to_str().unwrap(),
+    ]);
+    assert_fails(
+        &["merge", wide.to_str().unwrap()],
+        "shard 1/18446744073709551615 is missing",
+    );
     // Runs of the other kind into one folder: a whole run removes the
     // shards, a shard run the tables and shards of another split; a user's
     // own file stays.

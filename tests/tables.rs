@@ -496,6 +496,29 @@ fn a_sharded_table_run_merges_to_the_single_runs_bytes() {
         );
     }
     std::fs::write(&shard0, original).unwrap();
+    // Every shard claiming 10^18 sets: the claim is not allocated (a vector
+    // of 10^18 slots aborted), the first set no shard holds is named.
+    let names: Vec<_> = (0..3)
+        .map(|i| parts.join(format!("t.h.shard-{i}-of-3.json")))
+        .collect();
+    let kept: Vec<String> = names
+        .iter()
+        .map(|p| std::fs::read_to_string(p).unwrap())
+        .collect();
+    for (path, text) in names.iter().zip(&kept) {
+        let mut v: serde_json::Value = serde_json::from_str(text).unwrap();
+        v["run"]["sets"] = serde_json::json!(1_000_000_000_000_000_000u64);
+        std::fs::write(path, v.to_string()).unwrap();
+    }
+    let out = varspec(&merge);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("set 10 is in no shard"),
+        "{err}"
+    );
+    for (path, text) in names.iter().zip(&kept) {
+        std::fs::write(path, text).unwrap();
+    }
     std::fs::remove_file(parts.join("t.h.shard-1-of-3.json")).unwrap();
     let out = varspec(&merge);
     assert!(String::from_utf8_lossy(&out.stderr).contains("shard 1/3 is missing"));

@@ -116,7 +116,9 @@ impl Shard {
             return Err("no shards to merge".into());
         };
         let count = first.count;
-        let mut seen = vec![false; count];
+        // The indices seen, as many as the shards given: a count read from
+        // a file (2^64 − 1) is never allocated.
+        let mut seen = std::collections::BTreeSet::new();
         for (j, s) in shards.iter().enumerate() {
             if !same_run(j) || s.count != count {
                 return Err(format!(
@@ -124,11 +126,17 @@ impl Shard {
                     s.index, s.count, first.index
                 ));
             }
-            if std::mem::replace(&mut seen[s.index], true) {
+            if s.index >= count {
+                return Err(format!(
+                    "shard {}/{count} is not a part of a {count}-way split",
+                    s.index
+                ));
+            }
+            if !seen.insert(s.index) {
                 return Err(format!("shard {}/{count} given twice", s.index));
             }
         }
-        match seen.iter().position(|s| !s) {
+        match (0..count).find(|i| !seen.contains(i)) {
             Some(missing) => Err(format!("shard {missing}/{count} is missing")),
             None => Ok(()),
         }

@@ -85,31 +85,29 @@ pub fn merge_table_shards(shards: &[TableShard]) -> Result<(TableRun, Vec<PointS
         "table run",
     )?;
     let count = first.shard.count;
-    let mut sets: Vec<Option<PointSet>> = vec![None; first.run.sets];
+    // Keyed by index, as many as the shards hold: the set count a file
+    // states is never allocated before the sets are there.
+    let mut sets = std::collections::BTreeMap::new();
     for s in shards {
         for (r, coords) in &s.sets {
-            let slot = sets
-                .get_mut(*r)
-                .filter(|_| s.shard.owns(*r))
-                .ok_or_else(|| {
-                    format!("shard {}/{count} holds set {r}, not its own", s.shard.index)
-                })?;
-            if slot.is_some() {
+            if *r >= first.run.sets || !s.shard.owns(*r) {
+                return Err(format!(
+                    "shard {}/{count} holds set {r}, not its own",
+                    s.shard.index
+                ));
+            }
+            let set = PointSet::new(first.dim, coords.clone())
+                .map_err(|e| format!("set {r} of shard {}/{count}: {e}", s.shard.index))?;
+            if sets.insert(*r, set).is_some() {
                 return Err(format!(
                     "shard {}/{count} holds set {r} twice",
                     s.shard.index
                 ));
             }
-            *slot = Some(
-                PointSet::new(first.dim, coords.clone())
-                    .map_err(|e| format!("set {r} of shard {}/{count}: {e}", s.shard.index))?,
-            );
         }
     }
-    let sets = sets
-        .into_iter()
-        .enumerate()
-        .map(|(r, s)| s.ok_or_else(|| format!("set {r} is in no shard")))
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok((first.run.clone(), sets))
+    if let Some(r) = (0..first.run.sets).find(|r| !sets.contains_key(r)) {
+        return Err(format!("set {r} is in no shard"));
+    }
+    Ok((first.run.clone(), sets.into_values().collect()))
 }
