@@ -79,6 +79,21 @@ pub fn render_tour(tour: &Tour, folder: &Path) -> Result<(), TourError> {
 /// `context` (the tour's data, pictures embedded).
 fn page(name: &str, context: &Value) -> Result<String, TourError> {
     let mut env = minijinja::Environment::new();
+    // A number the tour could not measure is null in its data (serde_json
+    // writes NaN so); printf formatting refuses null, so the page says n/a
+    // there (a constant integrand's 0/0 failed the whole page after the work).
+    env.add_filter(
+        "format",
+        |state: &minijinja::State,
+         spec: &minijinja::Value,
+         args: minijinja::value::Rest<minijinja::Value>| {
+            if args.iter().any(|v| v.is_none() || v.is_undefined()) {
+                Ok(minijinja::Value::from_safe_string("n/a".into()))
+            } else {
+                minijinja::filters::format(state, spec, args)
+            }
+        },
+    );
     for (template, text) in TEMPLATES {
         env.add_template(template, text).map_err(fail)?;
     }
@@ -91,30 +106,39 @@ fn page(name: &str, context: &Value) -> Result<String, TourError> {
 mod tests {
     use super::*;
 
-    /// The shear section alone, drawn for a light field with `analytic`
-    /// layer shears.
-    fn shear_page(analytic: &[[f64; 2]]) -> String {
-        let context = serde_json::json!({ "shear": {
+    /// The shear section's data for a light field with `analytic` layer
+    /// shears.
+    fn shear_context(analytic: &[[f64; 2]]) -> Value {
+        serde_json::json!({ "shear": {
             "integrand": "light-field", "n": 256, "shear": [-0.15, -0.15],
             "initial": [-0.12, -0.12], "initial_value": 8e-5, "analytic": analytic,
             "unsheared": 8e-5, "optimum": 7.7e-5, "truncation_bound": 0.001,
             "reduction": 1.04, "check_before": 8e-5, "check_before_low": 7e-5,
             "check_before_high": 9e-5, "check_after": 7.6e-5, "check_after_low": 7e-5,
             "check_after_high": 8e-5, "seconds": 1.0, "spectra": [], "commands": []
-        }});
-        page("shear.html", &context).unwrap()
+        }})
     }
 
     #[test]
     fn a_double_wedge_is_drawn_as_two_layers() {
-        let two = shear_page(&[[-0.5, -0.5], [0.2, 0.2]]);
+        let two = page("shear.html", &shear_context(&[[-0.5, -0.5], [0.2, 0.2]])).unwrap();
         assert!(two.contains("2 sheared planes"), "{two}");
         assert!(two.contains("double wedge"));
         assert!(two.contains("analytic −c, layer 1</td><td>(-0.500, -0.500)"));
         assert!(two.contains("analytic −c, layer 2</td><td>(0.200, 0.200)"));
-        let one = shear_page(&[[-0.45, -0.45]]);
+        let one = page("shear.html", &shear_context(&[[-0.45, -0.45]])).unwrap();
         assert!(one.contains("the sheared plane"), "{one}");
         assert!(!one.contains("double wedge") && !one.contains("layer 1"));
         assert!(one.contains("analytic −c</td><td>(-0.450, -0.450)"));
+    }
+
+    /// A number the tour could not measure is null in its data (a NaN):
+    /// the page says n/a there instead of failing to render after the work.
+    #[test]
+    fn an_unmeasured_number_reads_n_a() {
+        let mut context = shear_context(&[[-0.45, -0.45]]);
+        context["shear"]["check_after_low"] = Value::Null;
+        let text = page("shear.html", &context).unwrap();
+        assert!(text.contains("7.600e-05 [n/a, 8.000e-05]"), "{text}");
     }
 }

@@ -327,6 +327,16 @@ impl TourOptions {
                 f.dim()
             )));
         }
+        // A constant has no error to compare (every ratio 0/0).
+        let constant = |option: &'static str, spec: &str| {
+            Err(at(option)(format!(
+                "`{spec}` is constant (variance 0): every point set integrates it exactly, so \
+                 there is nothing to compare; give one that varies"
+            )))
+        };
+        if f.variance() == 0.0 {
+            return constant("the integrand (--integrand)", &self.integrand);
+        }
         // Section 1's exact spatial form is O(N²) per set.
         let pairs = SECTION_ONE_SAMPLERS as f64
             * self.sets as f64
@@ -349,6 +359,9 @@ impl TourOptions {
                 "`{}` is not a light field; the shear search takes defocus:… or layers:…",
                 self.pixel
             )));
+        }
+        if pixel.variance() == 0.0 {
+            return constant("the pixel (--pixel)", &self.pixel);
         }
         Ok(())
     }
