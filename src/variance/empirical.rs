@@ -6,7 +6,8 @@
 //! a 95% confidence interval by Bonett's log-scale form with the same
 //! kurtosis ([`bonett_interval`]) — both account for the kurtosis of Î
 //! (indicator integrands are far from normal, where the χ² interval would
-//! be badly off).
+//! be badly off). Below 8 realizations, where no kurtosis can be estimated,
+//! the interval is the χ² one of normal estimates ([`chi_square_interval`]).
 
 use rayon::prelude::*;
 
@@ -196,6 +197,7 @@ impl EmpiricalEstimate {
         let half_width = NORMAL_95 * var_of_var.sqrt();
         let (ci_low, ci_high) = if m2 > 0.0 {
             bonett_interval(values, variance, NORMAL_95)
+                .or_else(|| chi_square_interval(variance, realizations))
                 .unwrap_or(((variance - half_width).max(0.0), variance + half_width))
         } else {
             // Every realization gave the same estimate (an integrand whose
@@ -241,9 +243,66 @@ fn bonett_interval(values: &[f64], s2: f64, z: f64) -> Option<(f64, f64)> {
     Some(((centre - z * se).exp(), (centre + z * se).exp()))
 }
 
+/// χ²_(R−1) quantiles at 0.025 and 0.975 for R − 1 = 1 … 6
+/// (scipy.stats.chi2.ppf, computed outside the project).
+const CHI_SQUARE_95: [(f64, f64); 6] = [
+    (0.000_982_069_117_175_255_5, 5.023_886_187_314_888),
+    (0.050_635_615_968_579_75, 7.377_758_908_227_871),
+    (0.215_795_282_623_897_85, 9.348_403_604_496_148),
+    (0.484_418_557_087_929_9, 11.143_286_781_877_796),
+    (0.831_211_613_486_662_5, 12.832_501_994_030_027),
+    (1.237_344_245_791_202_7, 14.449_375_335_447_92),
+];
+
+/// The 95% interval of a variance from R = 2 … 7 normal estimates:
+/// (R − 1)s²/χ²_(R−1) between its 0.975 and 0.025 quantiles, exact when
+/// Î is normal (its N summands make it nearly so). Too few realizations
+/// for Bonett's kurtosis; the symmetric interval s² ± 1.96·SE it replaces
+/// covered the truth 49% of the time at R = 3 (jitter, N = 16, a Gaussian;
+/// 200 seeds: stress probe). None for other R.
+fn chi_square_interval(s2: f64, realizations: usize) -> Option<(f64, f64)> {
+    let (low, high) = *CHI_SQUARE_95.get(realizations.checked_sub(2)?)?;
+    let ss = s2 * (realizations - 1) as f64;
+    Some((ss / high, ss / low))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Below 8 realizations the interval is the χ² one: 95% coverage for
+    /// normal estimates at every R = 2 … 7 (the symmetric interval it
+    /// replaced covered about half the time at R = 3). 4000 trials per R
+    /// (fixed seed): a true 95% leaves the observed coverage within ±0.0134
+    /// (3.89 standard errors, 99.99%).
+    #[test]
+    fn few_realizations_get_the_chi_square_interval() {
+        let (low, high) = chi_square_interval(1.0, 3).unwrap();
+        assert!((low - 2.0 / 7.377_758_908_227_871).abs() < 1e-15 && (high - 39.497).abs() < 1e-3);
+        assert!(chi_square_interval(1.0, 8).is_none() && chi_square_interval(1.0, 1).is_none());
+        let mut rng = set_rng(0x5eed_c41, 0);
+        for r in 2..8 {
+            let trials = 4000;
+            let covered = (0..trials)
+                .filter(|_| {
+                    // Box–Muller: standard normal estimates, true variance 1.
+                    let values: Vec<f64> = (0..r)
+                        .map(|_| {
+                            let (u, v) = (uniform(&mut rng), uniform(&mut rng));
+                            (-2.0 * (1.0 - u).ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+                        })
+                        .collect();
+                    let e = EmpiricalEstimate::of(&values);
+                    e.ci_low <= 1.0 && 1.0 <= e.ci_high
+                })
+                .count();
+            let coverage = covered as f64 / trials as f64;
+            assert!(
+                (coverage - 0.95).abs() <= 0.0134,
+                "R = {r}: coverage {coverage} of the nominal 95% (99.99% band 0.9366-0.9634)"
+            );
+        }
+    }
 
     #[test]
     fn identical_estimates_bound_nothing_above_zero() {
