@@ -1089,15 +1089,16 @@ fn predict_runs_the_listed_methods() {
         "--json",
     ]);
     assert!(v["expected"]["variance"].as_f64().unwrap() > 0.0, "{v}");
+    // (On a 4D integrand: on a 2D one a shift in (x, y) is the full shift.)
     common::assert_fails(
         &[
             "predict",
             "--sampler",
-            "jitter",
+            "umj",
             "-n",
             "64",
             "--integrand",
-            "disk",
+            "defocus",
             "--method",
             "spatial,empirical",
             "--shift",

@@ -74,7 +74,7 @@ const T975: [f64; 30] = [
 /// table to 30, then the Cornish–Fisher expansion in 1/ν around the normal
 /// quantile z (Abramowitz & Stegun 26.7.5, four terms; relative error
 /// below 2e-8 from ν = 31 on).
-fn t975(dof: usize) -> f64 {
+pub(super) fn t975(dof: usize) -> f64 {
     if let Some(&t) = T975.get(dof.wrapping_sub(1)) {
         return t;
     }

@@ -55,6 +55,11 @@ fn estimate(f: &dyn Integrand, set: &PointSet, shift: &[f64]) -> f64 {
     acc.value() / set.intensity()
 }
 
+/// Realizations from which a kurtosis is estimated for an interval
+/// (Bonett's; the paired ratio's delta method); below, the intervals are
+/// those of normal estimates.
+pub(super) const KURTOSIS_REALIZATIONS: usize = 8;
+
 /// The two-sided 95% quantile of the standard normal, Φ⁻¹(0.975).
 pub const NORMAL_95: f64 = 1.959_963_984_540_054;
 
@@ -225,7 +230,7 @@ impl EmpiricalEstimate {
 /// log scale lifts the upper end. None below 8 realizations.
 fn bonett_interval(values: &[f64], s2: f64, z: f64) -> Option<(f64, f64)> {
     let n = values.len();
-    if n < 8 || s2 <= 0.0 {
+    if n < KURTOSIS_REALIZATIONS || s2 <= 0.0 {
         return None;
     }
     let r = n as f64;
