@@ -492,7 +492,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             // converge and the experiment tables say.
             let rounding = v["variance"].as_f64().zip(v["rounding_bound"].as_f64());
             let zero = rounding.is_some_and(|(x, b)| varspec::variance::zero_to_rounding(x, b));
+            // A coarse --tol's transform error, not the arithmetic's, can
+            // put the Fourier form below its bound: that is a value the
+            // tolerance does not resolve, not a zero (jitter on a disk at
+            // --tol 1e-3 read "0 to rounding" beside a spatial 7.46e-5).
+            let coarse = a.tol.filter(|&t| key == "fourier" && t > DEFAULT_TOLERANCE);
             let variance = match v["variance"].as_f64() {
+                _ if zero && coarse.is_some() => "unresolved".to_string(),
                 _ if zero => "0 to rounding".to_string(),
                 Some(x) => format!("{x:.6e}"),
                 None => "n/a".to_string(),
@@ -546,8 +552,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
                     None => format!("{extra} unknown (one set: draw 2 or more with --sets)"),
                 },
             };
-            let note = match rounding {
-                Some((x, b)) if zero => {
+            let note = match (rounding, coarse) {
+                (Some((x, b)), Some(t)) if zero => format!(
+                    "({x:.4e} <= its error bound {b:.2e} at --tol {t:e}: a smaller --tol resolves it)  {note}"
+                ),
+                (Some((x, b)), _) if zero => {
                     format!("({x:.4e} <= its rounding bound {b:.2e})  {note}")
                 }
                 _ => note,
