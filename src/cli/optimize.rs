@@ -465,6 +465,15 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
             other_n(v, a.n)
         );
     }
+    if let Some((name, v)) = design.beaten_by() {
+        eprintln!(
+            "warning: the design's exact variance {:.4e} is above {name}'s {v:.4e} on its own \
+             target: the start ({}) is a point the descent does not leave (a lattice aliases a \
+             target whose frequencies are multiples of N); try --init {name}",
+            design.exact_variance.unwrap_or(f64::NAN),
+            design.run.init
+        );
+    }
     let baselines: Vec<(&str, f64)> = design.baselines.iter().map(|b| (b.name, b.score)).collect();
     design_outputs(
         &a,
