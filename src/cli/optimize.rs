@@ -524,9 +524,9 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     }
     let closest = design.closest_pair_over_hexagonal;
     outln!(
-        "  closest pair / hexagonal spacing: XY {:.3}, UV {:.3}",
-        closest.xy,
-        closest.uv
+        "  closest pair / hexagonal spacing: XY {}, UV {}",
+        spacing(closest.xy),
+        spacing(closest.uv)
     );
     design_outputs(
         &a,
@@ -540,6 +540,16 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
 /// A note for a comparison row whose sampler drew another N than the
 /// design's (the nearest its structure allows: jitter's m^d), empty
 /// otherwise: its scores are not at equal N.
+/// A closest pair over the hexagonal spacing, or why there is none (a set
+/// of one point has no pair: NaN or infinite, `null` in the JSON).
+fn spacing(ratio: f64) -> String {
+    if ratio.is_finite() {
+        format!("{ratio:.3}")
+    } else {
+        "n/a (one point)".into()
+    }
+}
+
 fn other_n(row: &serde_json::Value, n: usize) -> String {
     match row["n"].as_u64() {
         Some(m) if m != n as u64 => {
@@ -619,10 +629,12 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
             })
             .collect();
         outln!(
-            "  {name:<14}{mses}  closest pair {:.3}{}",
-            v["closest_pair_over_hexagonal"]
-                .as_f64()
-                .unwrap_or(f64::NAN),
+            "  {name:<14}{mses}  closest pair {}{}",
+            spacing(
+                v["closest_pair_over_hexagonal"]
+                    .as_f64()
+                    .unwrap_or(f64::NAN)
+            ),
             other_n(v, a.n)
         );
     }
