@@ -107,6 +107,11 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // The default shrinks to fit (to 99% of the largest range that does),
     // saying so; a range given is kept or refused.
     let half = 0.5 / unit;
+    // What the spacing is of, as the messages name it.
+    let spaced = match sets[0].density() {
+        Some(density) => format!("density {density}"),
+        None => format!("N = {n}"),
+    };
     let mut largest = half - KERNEL_REACH * bandwidth;
     if given.is_none() && range >= largest {
         // The range alone while it spans MIN_RANGE_IN_BANDWIDTHS kernel
@@ -128,7 +133,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             (range, bandwidth) = (shrunk_range, shrunk_bandwidth);
             largest = half - KERNEL_REACH * bandwidth;
             eprintln!(
-                "note: --range {range:.3} r_max (not {DEFAULT_RANGE}){}: with N = {n} in {d}D \
+                "note: --range {range:.3} r_max (not {DEFAULT_RANGE}){}: with {spaced} in {d}D \
                  half the torus is {half:.3} r_max, and the range plus 6 kernel widths \
                  ({:.3} r_max) must stay below it, where the pair correlation would alias",
                 if narrower {
@@ -143,8 +148,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let reach = range + KERNEL_REACH * bandwidth;
     if reach * unit >= 0.5 {
         bail!(
-            "--range {:?} + 6 x --bandwidth {:?} = {reach:.3} packing distances reaches half the torus \
-             (r_max = {unit:.4} for N = {n}: the pair correlation aliases beyond {:.3} r_max); {}",
+            "{}--range {:?} + 6 x --bandwidth {:?} = {reach:.3} packing distances reaches half the torus \
+             (r_max = {unit:.4} for {spaced}: the pair correlation aliases beyond {:.3} r_max); {}",
+            // Not given: the default could not shrink below the bandwidth.
+            if given.is_none() { "the default " } else { "" },
             range,
             bandwidth,
             0.5 / unit,
