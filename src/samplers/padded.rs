@@ -25,19 +25,35 @@ impl Padded {
     /// # Errors
     /// [`SamplerError::Param`] unless both are 2D with the same fixed N.
     pub fn new(xy: Box<dyn Sampler>, uv: Box<dyn Sampler>) -> Result<Self, SamplerError> {
-        let fixed = xy.density().is_none() && uv.density().is_none();
-        if xy.dim() != 2 || uv.dim() != 2 || xy.points_per_set() != uv.points_per_set() || !fixed {
+        // The half at fault is named (both were reported together as
+        // "xy/uv=2D with 4 points / 2D with 4 points").
+        for (key, half) in [("xy", &xy), ("uv", &uv)] {
+            let fault = if half.dim() != 2 {
+                Some((format!("a {}D sampler", half.dim()), "a 2D sampler"))
+            } else if half.density().is_some() {
+                Some((
+                    "a random-count sampler".to_string(),
+                    "a sampler of a fixed N (a random count, as isotropic-jitter's, cannot be \
+                     paired point by point)",
+                ))
+            } else {
+                None
+            };
+            if let Some((value, expected)) = fault {
+                return Err(SamplerError::Param {
+                    sampler: "padded",
+                    key,
+                    value,
+                    expected: expected.into(),
+                });
+            }
+        }
+        if xy.points_per_set() != uv.points_per_set() {
             return Err(SamplerError::Param {
                 sampler: "padded",
                 key: "xy/uv",
-                value: format!(
-                    "{}D with {} points / {}D with {} points",
-                    xy.dim(),
-                    xy.points_per_set(),
-                    uv.dim(),
-                    uv.points_per_set()
-                ),
-                expected: "two 2D samplers of the same fixed N (a random-count sampler such as isotropic-jitter cannot be paired)".into(),
+                value: format!("{} / {} points", xy.points_per_set(), uv.points_per_set()),
+                expected: "two 2D samplers of the same N".into(),
             });
         }
         Ok(Padded { xy, uv })
