@@ -148,12 +148,19 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let reach = range + KERNEL_REACH * bandwidth;
     if reach * unit >= 0.5 {
         bail!(
-            "{}--range {:?} + 6 x --bandwidth {:?} = {reach:.3} packing distances reaches half the torus \
+            "{}--range {:?} + 6 x --bandwidth {:?} = {} packing distances reaches half the torus \
              (r_max = {unit:.4} for {spaced}: the pair correlation aliases beyond {:.3} r_max); {}",
             // Not given: the default could not shrink below the bandwidth.
             if given.is_none() { "the default " } else { "" },
             range,
             bandwidth,
+            // Three decimals, in exponent form beyond (--range 1e300 printed
+            // 300 digits).
+            if reach < 1e6 {
+                format!("{reach:.3}")
+            } else {
+                format!("{reach:.3e}")
+            },
             0.5 / unit,
             if largest > bandwidth {
                 format!("lower --range to below {largest:.3}, or use more points")

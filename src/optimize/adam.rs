@@ -81,7 +81,8 @@ impl AdamOptions {
             Ok(rel_tol)
         } else {
             Err(super::OptimizeError::Option(format!(
-                "--rel-tol {rel_tol}: the relative improvement over 50 iterations below which the descent stops must be in [0, 1) (0: never stop early)"
+                "--rel-tol {}: the relative improvement over 50 iterations below which the descent stops must be in [0, 1) (0: never stop early)",
+                crate::spec_params::SpecValue(rel_tol)
             )))
         }
     }

@@ -168,7 +168,8 @@ pub fn search_and_check(
     let mut warnings = Vec::new();
     if widest > range {
         warnings.push(format!(
-            "the spectrum asks for a shear of up to {widest:.3} on an axis, outside --range {range}: the search stops at the range; widen it (or leave --range out)"
+            "the spectrum asks for a shear of up to {widest:.3} on an axis, outside --range {}: the search stops at the range; widen it (or leave --range out)",
+            crate::spec_params::SpecValue(range)
         ));
     }
     starts.push([0.0, 0.0]);
