@@ -820,26 +820,8 @@ fn two_dimensional_predictions_say_what_they_are() {
     let dir = common::temp_dir("predict-2d");
     let one = dir.join("j1.csv");
     let four = dir.join("u4.csv");
-    common::varspec_ok(&[
-        "sample",
-        "jitter",
-        "-n",
-        "64",
-        "--sets",
-        "1",
-        "-o",
-        one.to_str().unwrap(),
-    ]);
-    common::varspec_ok(&[
-        "sample",
-        "umj",
-        "-n",
-        "64",
-        "--sets",
-        "2",
-        "-o",
-        four.to_str().unwrap(),
-    ]);
+    common::sample_file("jitter", 64, 1, &one);
+    common::sample_file("umj", 64, 2, &four);
     let base = [
         "predict",
         one.to_str().unwrap(),
@@ -880,16 +862,7 @@ fn two_dimensional_predictions_say_what_they_are() {
 fn unshifted_predict_on_a_file_takes_each_set_once() {
     let dir = common::temp_dir("predict-unshifted");
     let sets = dir.join("j8.csv");
-    common::varspec_ok(&[
-        "sample",
-        "jitter",
-        "-n",
-        "64",
-        "--sets",
-        "8",
-        "-o",
-        sets.to_str().unwrap(),
-    ]);
+    common::sample_file("jitter", 64, 8, &sets);
     let base = [
         "predict",
         sets.to_str().unwrap(),

@@ -69,6 +69,13 @@ pub fn temp_dir(tag: &str) -> PathBuf {
     dir
 }
 
+/// Writes `sets` sets of `n` points of `sampler` (seed 0) to `path`.
+pub fn sample_file(sampler: &str, n: usize, sets: usize, path: &std::path::Path) {
+    let (n, sets) = (n.to_string(), sets.to_string());
+    let path = path.to_str().unwrap();
+    varspec_ok(&["sample", sampler, "-n", &n, "--sets", &sets, "-o", path]);
+}
+
 /// Asserts that `varspec args` fails with a message containing `phrase`
 /// and without a panic.
 pub fn assert_fails(args: &[&str], phrase: &str) {
