@@ -535,6 +535,19 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
             "far.obj line 4: face vertex index out of bounds: `f 1 2 9`",
         ),
+        // tobj ignores a face of two vertices (a line) and checks the next
+        // one; a texture index 0 reads as missing (review).
+        (
+            "line.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1 9\nf 1/0 2/1 3/1\nf 1 2 8\n",
+            "line.obj line 7: face vertex index out of bounds",
+        ),
+        // The vertex a face uses, not an unused one out of range before it.
+        (
+            "unused.obj",
+            "v 0 0 0\nv 1e30 0 0\nv 1 0 0\nv 0 1 0\nv inf 0 0\nf 1 3 5\n",
+            "unused.obj line 5: `v inf 0 0`",
+        ),
         (
             "before.obj",
             "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\nf 1 2 3\n",

@@ -466,12 +466,20 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
         );
     }
     if let Some((name, v)) = design.beaten_by() {
+        // Why, where it is known: a start returned unchanged.
+        let why = if design.kept_start > 0 {
+            format!(
+                "the start ({}) is a point the descent does not leave (a lattice aliases a \
+                 target whose frequencies are multiples of N); ",
+                design.run.init
+            )
+        } else {
+            "more --iters may help; ".into()
+        };
         eprintln!(
             "warning: the design's exact variance {:.4e} is above {name}'s {v:.4e} on its own \
-             target: the start ({}) is a point the descent does not leave (a lattice aliases a \
-             target whose frequencies are multiples of N); try --init {name}",
+             target: {why}try --init {name}",
             design.exact_variance.unwrap_or(f64::NAN),
-            design.run.init
         );
     }
     let baselines: Vec<(&str, f64)> = design.baselines.iter().map(|b| (b.name, b.score)).collect();
@@ -537,9 +545,6 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
     )
 }
 
-/// A note for a comparison row whose sampler drew another N than the
-/// design's (the nearest its structure allows: jitter's m^d), empty
-/// otherwise: its scores are not at equal N.
 /// A closest pair over the hexagonal spacing, or why there is none (a set
 /// of one point has no pair: NaN or infinite, `null` in the JSON).
 fn spacing(ratio: f64) -> String {
@@ -550,6 +555,9 @@ fn spacing(ratio: f64) -> String {
     }
 }
 
+/// A note for a comparison row whose sampler drew another N than the
+/// design's (the nearest its structure allows: jitter's m^d), empty
+/// otherwise: its scores are not at equal N.
 fn other_n(row: &serde_json::Value, n: usize) -> String {
     match row["n"].as_u64() {
         Some(m) if m != n as u64 => {
@@ -980,8 +988,14 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
                 after.ci_low,
                 upper(after.ci_high),
                 run.ratio.map_or(String::new(), |r| format!(
-                    "; paired ratio {:.3} [{:.3}, {:.3}]",
-                    r.ratio, r.ci_low, r.ci_high
+                    "; paired ratio {:.3} [{:.3}, {}]",
+                    r.ratio,
+                    r.ci_low,
+                    if r.ci_high.is_finite() {
+                        format!("{:.3}", r.ci_high)
+                    } else {
+                        "no upper end".into()
+                    }
                 ))
             );
         }

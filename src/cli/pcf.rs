@@ -109,7 +109,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let half = 0.5 / unit;
     // What the spacing is of, as the messages name it.
     let spaced = match sets[0].density() {
-        Some(density) => format!("density {density}"),
+        Some(density) => format!("density {}", varspec::spec_params::SpecValue(density)),
         None => format!("N = {n}"),
     };
     let mut largest = half - KERNEL_REACH * bandwidth;

@@ -554,7 +554,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             };
             let note = match (rounding, coarse) {
                 (Some((x, b)), Some(t)) if zero => format!(
-                    "({x:.4e} <= its error bound {b:.2e} at --tol {t:e}: a smaller --tol resolves it)  {note}"
+                    "({x:.4e} <= its error bound {b:.2e} at --tol {t:e}: a smaller --tol may resolve it)  {note}"
                 ),
                 (Some((x, b)), _) if zero => {
                     format!("({x:.4e} <= its rounding bound {b:.2e})  {note}")

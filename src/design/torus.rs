@@ -142,7 +142,7 @@ impl TorusDesign {
     /// classic samplers' means are over 8 or more sets) and the rounding
     /// bound: a start the descent could not leave (every N-point lattice
     /// holds N·Z² in its dual, so `cos:kx=64` at N = 16 is aliased by all
-    /// of them: 0.5 against CMJ's 0.03, returned without a word).
+    /// of them: 0.5 against Sobol's 0.017, returned without a word).
     #[must_use]
     pub fn beaten_by(&self) -> Option<(&str, f64)> {
         let design = self.exact_variance?;

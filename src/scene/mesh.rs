@@ -129,7 +129,13 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
                 words.next() == Some("v")
                     && words
                         .take(3)
-                        .any(|w| w.parse::<f32>().is_ok_and(out_of_range))
+                        // The value itself, not just any out of range: tobj
+                        // keeps only vertices that faces use.
+                        .any(|w| {
+                            w.parse::<f32>().is_ok_and(|v| {
+                                v.to_bits() == bad.to_bits() || (v.is_nan() && bad.is_nan())
+                            })
+                        })
             });
             return Err(match line {
                 Some((number, line)) => format!(
@@ -192,7 +198,9 @@ fn obj_error_line<'a>(text: &'a str, error: &tobj::LoadError) -> Option<(usize, 
     // The slots of `v/vt/vn`, each an index or empty; None if it is not one.
     let slots = |word: &str| -> Option<Vec<Option<isize>>> {
         let parts: Vec<&str> = word.split('/').collect();
-        if parts.len() > 3 {
+        // tobj skips empty parts, so only a fourth that holds something
+        // fails (`1/1/1/` is read).
+        if parts.iter().skip(3).any(|p| !p.is_empty()) {
             return None;
         }
         parts
@@ -233,13 +241,15 @@ fn obj_error_line<'a>(text: &'a str, error: &tobj::LoadError) -> Option<(usize, 
             (Some("vt"), E::TexcoordParseError) => !floats(&words, 2),
             (Some("vn"), E::NormalParseError) => !floats(&words, 3),
             (Some("f" | "l"), E::FaceParseError) => words.iter().any(|w| slots(w).is_none()),
-            (Some("f"), _) => slot.is_some_and(|k| {
-                // tobj checks texture coordinates and normals only when the
-                // file has some.
+            // tobj checks the indices of faces of 3 or more vertices only
+            // (points and lines are ignored), and texture coordinates and
+            // normals only when the file has some; a coordinate or normal
+            // index 0 reads as missing, not as out of bounds.
+            (Some("f" | "l"), _) if words.len() >= 3 => slot.is_some_and(|k| {
                 (k == 0 || totals[k] > 0)
                     && words.iter().filter_map(|w| slots(w)).any(|s| {
                         s.get(k).copied().flatten().is_some_and(|i| {
-                            i == 0
+                            (i == 0 && k == 0)
                                 || (i > 0 && i.unsigned_abs() > totals[k])
                                 || (i < 0 && i.unsigned_abs() > before[k])
                         })

@@ -87,7 +87,8 @@ fn page(name: &str, context: &Value) -> Result<String, TourError> {
         |state: &minijinja::State,
          spec: &minijinja::Value,
          args: minijinja::value::Rest<minijinja::Value>| {
-            if args.iter().any(|v| v.is_none() || v.is_undefined()) {
+            // Only null: an undefined value is a template mistake and fails.
+            if args.iter().any(minijinja::Value::is_none) {
                 Ok(minijinja::Value::from_safe_string("n/a".into()))
             } else {
                 minijinja::filters::format(state, spec, args)
@@ -138,7 +139,12 @@ mod tests {
     fn an_unmeasured_number_reads_n_a() {
         let mut context = shear_context(&[[-0.45, -0.45]]);
         context["shear"]["check_after_low"] = Value::Null;
+        context["shear"]["truncation_bound"] = Value::Null;
         let text = page("shear.html", &context).unwrap();
         assert!(text.contains("7.600e-05 [n/a, 8.000e-05]"), "{text}");
+        assert!(text.contains("truncation bound n/a)"), "{text}");
+        // A misspelt field is a template mistake, not a missing number.
+        context["shear"].as_object_mut().unwrap().remove("optimum");
+        assert!(page("shear.html", &context).is_err());
     }
 }

@@ -199,11 +199,12 @@ impl EmpiricalEstimate {
         let m4 = sum(values.iter().map(|v| (v - mean).powi(4))) / r;
         let variance = m2 / (r - 1.0);
         let var_of_var = crate::sum::variance_of_sample_variance(m4, variance, realizations);
-        let half_width = NORMAL_95 * var_of_var.sqrt();
         let (ci_low, ci_high) = if m2 > 0.0 {
+            // Bonett's from 8 realizations, the χ² one below (R ≥ 2 here):
+            // one of them always answers.
             bonett_interval(values, variance, NORMAL_95)
                 .or_else(|| chi_square_interval(variance, realizations))
-                .unwrap_or(((variance - half_width).max(0.0), variance + half_width))
+                .unwrap_or((0.0, f64::INFINITY))
         } else {
             // Every realization gave the same estimate (an integrand whose
             // support no point met, say): the data bound nothing above 0.

@@ -162,6 +162,32 @@ mod tests {
         }
     }
 
+    /// From 8 pairs the delta method: identical samples give ratio 1 and
+    /// no width, a scaled copy the squared scale exactly.
+    #[test]
+    fn the_delta_method_is_exact_on_identities() {
+        let before = [0.1, 0.4, 0.2, 0.9, 0.3, 0.7, 0.55, 0.05];
+        let same = paired_ratio(&before, &before).unwrap();
+        assert!(
+            (same.ratio - 1.0).abs() < 1e-15 && (same.ci_high - same.ci_low).abs() < 1e-12,
+            "{same:?}"
+        );
+        let after: Vec<f64> = before.iter().map(|x| 0.5 * x).collect();
+        let scaled = paired_ratio(&before, &after).unwrap();
+        assert!(
+            (scaled.ratio - 0.25).abs() < 1e-15
+                && (scaled.ci_high / scaled.ci_low - 1.0).abs() < 1e-9,
+            "{scaled:?}"
+        );
+        // Not an identity: the interval has width.
+        let other = [0.3, 0.1, 0.8, 0.2, 0.6, 0.4, 0.9, 0.15];
+        let r = paired_ratio(&before, &other).unwrap();
+        assert!(
+            r.ci_low < r.ratio && r.ratio < r.ci_high && r.ci_high / r.ci_low > 1.5,
+            "{r:?}"
+        );
+    }
+
     #[test]
     fn degenerate_inputs_have_no_ratio() {
         assert_eq!(paired_ratio(&[1.0], &[1.0]), None);
