@@ -104,8 +104,7 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
     };
     let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| {
         // tobj's errors do not say where; the line is found again in the text.
-        let text = std::fs::read(path).unwrap_or_default();
-        let text = String::from_utf8_lossy(&text);
+        let text = obj_text(path);
         match obj_error_line(&text, &e) {
             Some((number, line)) => format!(
                 "a Wavefront OBJ file ({} line {number}: {e}: `{}`)",
@@ -122,8 +121,7 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         if let Some(bad) = positions.iter().copied().find(|&v| out_of_range(v)) {
             let expected = format!("finite vertex positions of magnitude at most {MAX_LENGTH:e}");
             // The line, where the value stands as written (a `w` divides it).
-            let text = std::fs::read(path).unwrap_or_default();
-            let text = String::from_utf8_lossy(&text);
+            let text = obj_text(path);
             let line = text.lines().enumerate().find(|(_, l)| {
                 let mut words = l.split_whitespace();
                 words.next() == Some("v")
@@ -182,6 +180,12 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         ));
     }
     Ok(triangles)
+}
+
+/// An OBJ file's text read again to locate an error (read once, only on
+/// the error path; bytes that are not UTF-8 become U+FFFD).
+fn obj_text(path: &Path) -> String {
+    String::from_utf8_lossy(&std::fs::read(path).unwrap_or_default()).into_owned()
 }
 
 /// The first line of an OBJ text that tobj's `error` is about (1-based, with

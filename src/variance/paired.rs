@@ -53,8 +53,9 @@ pub fn paired_ratio(before: &[f64], after: &[f64]) -> Option<VarianceRatio> {
         let mean = sum(v.iter().copied()) / r;
         v.iter().map(|x| x - mean).collect::<Vec<f64>>()
     };
-    let squares = |v: &[f64]| centred(v).iter().map(|x| x * x).collect::<Vec<f64>>();
-    let (a, b) = (squares(after), squares(before));
+    let (ca, cb) = (centred(after), centred(before));
+    let squares = |v: &[f64]| v.iter().map(|x| x * x).collect::<Vec<f64>>();
+    let (a, b) = (squares(&ca), squares(&cb));
     let (ma, mb) = (sum(a.iter().copied()) / r, sum(b.iter().copied()) / r);
     if !(ma > 0.0 && mb > 0.0) {
         return None;
@@ -65,7 +66,6 @@ pub fn paired_ratio(before: &[f64], after: &[f64]) -> Option<VarianceRatio> {
         // Lagrange's identity Σ_(i<j) (a_i·b_j − a_j·b_i)²: no cancellation,
         // and exactly 0 for proportional samples (the difference of squares
         // left 1e-16, which the square root below widened to 1e-8).
-        let (ca, cb) = (centred(after), centred(before));
         let minors = sum((0..n).flat_map(|i| {
             let (ca, cb) = (&ca, &cb);
             (i + 1..n).map(move |j| (ca[i] * cb[j] - ca[j] * cb[i]).powi(2))
