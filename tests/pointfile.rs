@@ -419,7 +419,14 @@ fn npy_point_sets_round_trip_and_read_what_numpy_writes() {
     refuse(
         "short.npy",
         npy_by_hand("<f8", false, "(4, 2)", &[0; 8]),
-        "cut short",
+        "states 8 values, the file holds 1",
+    );
+    // A shape of 2e11 values over 16 bytes: read as it grows, never
+    // allocated from the header.
+    refuse(
+        "huge.npy",
+        npy_by_hand("<f8", false, "(100000000000, 2)", &[0; 16]),
+        "states 200000000000 values, the file holds 2",
     );
     refuse(
         "empty.npy",

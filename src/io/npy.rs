@@ -91,10 +91,10 @@ pub fn read_point_sets_npy(mut reader: impl Read) -> Result<Vec<PointSet>, Strin
     let dtype = file.dtype();
     let values: Vec<f64> = match &dtype {
         DType::Plain(t) if *t == "<f8".parse::<TypeStr>().expect("valid") => {
-            collect(file.data::<f64>().map_err(|e| e.to_string())?)?
+            collect(file.data::<f64>().map_err(|e| e.to_string())?, &shape)?
         }
         DType::Plain(t) if *t == "<f4".parse::<TypeStr>().expect("valid") => {
-            collect(file.data::<f32>().map_err(|e| e.to_string())?)?
+            collect(file.data::<f32>().map_err(|e| e.to_string())?, &shape)?
                 .into_iter()
                 .map(f64::from)
                 .collect()
@@ -223,12 +223,26 @@ fn read_header_checked(reader: &mut impl Read) -> Result<Vec<u8>, String> {
     Ok(bytes)
 }
 
-/// Every element of a reader, or the read error (a truncated file).
-fn collect<T, R: Read>(data: npyz::NpyReader<T, R>) -> Result<Vec<T>, String>
+/// Every element of a reader, or how many of the `shape`'s values a
+/// truncated file holds (grown as read: a header's shape is never
+/// allocated up front).
+fn collect<T, R: Read>(data: npyz::NpyReader<T, R>, shape: &[u64]) -> Result<Vec<T>, String>
 where
     T: npyz::Deserialize,
 {
-    data.into_iter()
-        .collect::<io::Result<Vec<T>>>()
-        .map_err(|e| format!("the array's data is cut short: {e}"))
+    let mut values = Vec::new();
+    for value in data {
+        match value {
+            Ok(v) => values.push(v),
+            Err(e) => {
+                let stated: u64 = shape.iter().product();
+                return Err(format!(
+                    "the array's data is cut short: its shape {shape:?} states {stated} values, \
+                     the file holds {} ({e})",
+                    values.len()
+                ));
+            }
+        }
+    }
+    Ok(values)
 }
