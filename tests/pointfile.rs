@@ -125,6 +125,20 @@ fn every_malformed_input_names_its_line() {
             |p| matches!(p, LineProblem::NotFinite { .. }),
             "inf",
         ),
+        // A UTK file whose first value is a float spelt with letters: its
+        // value is refused, the line is not read as a CSV header.
+        (
+            "inf 0.5\n0.1 0.2\n",
+            1,
+            |p| matches!(p, LineProblem::NotFinite { field: 1, .. }),
+            "inf",
+        ),
+        (
+            "0.1 0.2\nNaN 0.5\n",
+            2,
+            |p| matches!(p, LineProblem::NotFinite { field: 1, .. }),
+            "NaN",
+        ),
         (
             "x0,x1\n0.1,1.0\n",
             2,

@@ -439,7 +439,7 @@ pub fn parse_point_sets<R: BufRead>(
         }
     }
     let text = first.trim();
-    if text.starts_with(|c: char| c.is_ascii_alphabetic()) {
+    if is_csv_header(text) {
         parser.csv_header(text).map_err(at(line))?;
         let mut csv = csv::ReaderBuilder::new()
             .has_headers(false)
@@ -537,7 +537,6 @@ impl Parser<'_> {
             return Ok(());
         }
         match self.format {
-            None if text.starts_with(|c: char| c.is_ascii_alphabetic()) => self.csv_header(text),
             None if text.starts_with('#') => {
                 self.format = Some(PointFormat::Utk);
                 Ok(())
@@ -654,6 +653,18 @@ impl Parser<'_> {
         }
         Ok(self.sets)
     }
+}
+
+/// A first line that begins with a letter is a CSV header, unless it is a
+/// comma-free row whose first field Rust reads as a float (`inf 0.5`,
+/// `NaN 0.1`): a UTK row, whose value is then refused by name.
+fn is_csv_header(text: &str) -> bool {
+    let utk_number_row = !text.contains(',')
+        && text
+            .split_whitespace()
+            .next()
+            .is_some_and(|f| f.parse::<f64>().is_ok());
+    text.starts_with(|c: char| c.is_ascii_alphabetic()) && !utk_number_row
 }
 
 fn coordinate(text: &str, field: usize) -> Result<f64, LineProblem> {
