@@ -553,6 +553,13 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
             "v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\nf 1 2 3\n",
             "before.obj line 3: face vertex index out of bounds",
         ),
+        // tobj checks a model's faces when a `g`/`o` line closes it,
+        // against the vertices read by then (a later vertex does not count).
+        (
+            "split.obj",
+            "v 0 0 0\nv 1 0 0\nf 1 2 3\ng second\nv 0 1 0\nf 1 2 3\n",
+            "split.obj line 3: face vertex index out of bounds: `f 1 2 3`",
+        ),
         (
             "normal.obj",
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf 1//1 2//1 3//2\n",

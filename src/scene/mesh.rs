@@ -191,8 +191,10 @@ fn obj_text(path: &Path) -> String {
 /// The first line of an OBJ text that tobj's `error` is about (1-based, with
 /// its text), for the errors one line causes: a position (`v`), texture
 /// coordinate (`vt`) or normal (`vn`) that does not parse, a face (`f`, `l`)
-/// that does not, or a face index past the vertices, coordinates or normals
-/// of the file (tobj checks a relative index against those before it).
+/// that does not, or a face index past the vertices, coordinates or normals.
+/// tobj checks a relative index against those before its face, and the
+/// others when it closes the face's model (at the next `g` or `o` line after
+/// faces, or the end of the file) against those read by then.
 /// `None` for other errors, or where the text shows none.
 fn obj_error_line<'a>(text: &'a str, error: &tobj::LoadError) -> Option<(usize, &'a str)> {
     use tobj::LoadError as E;
@@ -223,13 +225,32 @@ fn obj_error_line<'a>(text: &'a str, error: &tobj::LoadError) -> Option<(usize, 
         _ => None,
     };
     let keys = ["v", "vt", "vn"];
-    let total = |key: &str| {
-        text.lines()
-            .filter(|l| l.split_whitespace().next() == Some(key))
-            .count()
+    // Whether a face's index in slot k falls outside the `seen` elements at
+    // its model's close, `before` them at the face itself (relative ones).
+    // tobj checks the indices of faces of 3 or more vertices only (points
+    // and lines are ignored), coordinates and normals only when the file
+    // has some by then; a coordinate or normal index 0 reads as missing.
+    let out_of_bounds = |words: &[&str], k: usize, before: [usize; 3], seen: [usize; 3]| {
+        words.len() >= 3
+            && (k == 0 || seen[k] > 0)
+            && words.iter().filter_map(|w| slots(w)).any(|s| {
+                s.get(k).copied().flatten().is_some_and(|i| {
+                    (i == 0 && k == 0)
+                        || (i > 0 && i.unsigned_abs() > seen[k])
+                        || (i < 0 && i.unsigned_abs() > before[k])
+                })
+            })
     };
-    let totals = keys.map(total);
     let mut before = [0usize; 3];
+    // The current model's faces: line number, text, words, counts before.
+    let mut faces: Vec<(usize, &str, Vec<&str>, [usize; 3])> = Vec::new();
+    let close = |faces: &[(usize, &'a str, Vec<&str>, [usize; 3])], seen: [usize; 3]| {
+        let k = slot?;
+        faces
+            .iter()
+            .find(|(_, _, words, at)| out_of_bounds(words, k, *at, seen))
+            .map(|&(number, line, _, _)| (number, line))
+    };
     for (number, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let key = words.next();
@@ -245,28 +266,24 @@ fn obj_error_line<'a>(text: &'a str, error: &tobj::LoadError) -> Option<(usize, 
             (Some("vt"), E::TexcoordParseError) => !floats(&words, 2),
             (Some("vn"), E::NormalParseError) => !floats(&words, 3),
             (Some("f" | "l"), E::FaceParseError) => words.iter().any(|w| slots(w).is_none()),
-            // tobj checks the indices of faces of 3 or more vertices only
-            // (points and lines are ignored), and texture coordinates and
-            // normals only when the file has some; a coordinate or normal
-            // index 0 reads as missing, not as out of bounds.
-            (Some("f" | "l"), _) if words.len() >= 3 => slot.is_some_and(|k| {
-                (k == 0 || totals[k] > 0)
-                    && words.iter().filter_map(|w| slots(w)).any(|s| {
-                        s.get(k).copied().flatten().is_some_and(|i| {
-                            (i == 0 && k == 0)
-                                || (i > 0 && i.unsigned_abs() > totals[k])
-                                || (i < 0 && i.unsigned_abs() > before[k])
-                        })
-                    })
-            }),
             _ => false,
         };
         if bad {
             return Some((number + 1, line));
         }
+        match key {
+            Some("f" | "l") => faces.push((number + 1, line, words, before)),
+            Some("g" | "o") if !faces.is_empty() => {
+                if let Some(found) = close(&faces, before) {
+                    return Some(found);
+                }
+                faces.clear();
+            }
+            _ => {}
+        }
         if let Some(k) = keys.iter().position(|&k| Some(k) == key) {
             before[k] += 1;
         }
     }
-    None
+    close(&faces, before)
 }
