@@ -58,6 +58,12 @@ impl Integrand for Cosine {
         1.0 + cos_turns(self.phase(x))
     }
 
+    fn eval_shifted(&self, x: &[f64], s: &[f64]) -> f64 {
+        // k₀·(x + s) = k₀·x + k₀·s mod 1, each reduced exactly: no
+        // rounding of x + s enters the phase.
+        1.0 + cos_turns(self.phase(x) + self.phase(s))
+    }
+
     fn fourier(&self, k: &[i64]) -> Complex64 {
         let re = match (k[0], k[1]) {
             (0, 0) => self.integral(),

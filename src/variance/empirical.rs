@@ -42,15 +42,9 @@ pub struct EmpiricalEstimate {
 /// Î = Σ f(x_j + s)/intensity for one realization under shift `s` (the
 /// intensity is N, or the density λ of a random-count process).
 fn estimate(f: &dyn Integrand, set: &PointSet, shift: &[f64]) -> f64 {
-    let d = set.dim();
-    let mut y = [0.0; 4];
     let mut acc = NeumaierSum::default();
     for p in set.points() {
-        for j in 0..d {
-            let v = p[j] + shift[j];
-            y[j] = if v >= 1.0 { v - 1.0 } else { v };
-        }
-        acc.add(f.eval(&y[..d]));
+        acc.add(f.eval_shifted(p, shift));
     }
     acc.value() / set.intensity()
 }
