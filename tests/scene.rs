@@ -889,6 +889,7 @@ fn the_pilot_measures_only_occlusion_edges_and_pinhole_pixels_are_not_warped() {
         ShearPolicy::Analytic,
         &analysis,
         5,
+        &|| {},
     )
     .unwrap();
     let pilot = pixel_shears(
@@ -897,6 +898,7 @@ fn the_pilot_measures_only_occlusion_edges_and_pinhole_pixels_are_not_warped() {
         ShearPolicy::Pilot { pilots: 4 },
         &analysis,
         5,
+        &|| {},
     )
     .unwrap();
     let edges = analysis

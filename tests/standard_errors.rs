@@ -234,7 +234,15 @@ fn the_mean_pixel_variance_standard_error_matches_replicates() {
     let scene = Scene::from_text(&text, "dof-24").unwrap();
     let umj = registry::build("umj", 16, Some(4), &[]).unwrap();
     let analysis = analyse(&scene);
-    let shears = pixel_shears(&scene, umj.as_ref(), ShearPolicy::Analytic, &analysis, 0).unwrap();
+    let shears = pixel_shears(
+        &scene,
+        umj.as_ref(),
+        ShearPolicy::Analytic,
+        &analysis,
+        0,
+        &|| {},
+    )
+    .unwrap();
     for renders in [4, 16] {
         let replicates: Vec<(f64, f64)> = (0..300u64)
             .map(|seed| {

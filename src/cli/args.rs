@@ -349,6 +349,11 @@ pub fn frequency_box(text: &str) -> Result<usize, String> {
 
 /// A whole number of at least `MIN`, as [`whole`].
 pub fn whole_at_least<const MIN: u64, T: TryFrom<u64>>(text: &str) -> Result<T, String> {
+    whole_in::<MIN, { u64::MAX }, T>(text)
+}
+
+/// A whole number in [`MIN`, `MAX`], as [`whole`].
+pub fn whole_in<const MIN: u64, const MAX: u64, T: TryFrom<u64>>(text: &str) -> Result<T, String> {
     let value = parse_whole(text).map_err(|e| match e {
         NotWhole::Negative => format!("`{text}` is negative; expected a whole number >= {MIN}"),
         NotWhole::Fraction => format!("`{text}` is not a whole number"),
@@ -357,6 +362,9 @@ pub fn whole_at_least<const MIN: u64, T: TryFrom<u64>>(text: &str) -> Result<T, 
     })?;
     if value < MIN {
         return Err(format!("`{text}`: expected a whole number >= {MIN}"));
+    }
+    if value > MAX {
+        return Err(format!("`{text}`: expected a whole number <= {MAX}"));
     }
     T::try_from(value).map_err(|_| format!("`{text}` is too large for this option"))
 }

@@ -15,8 +15,8 @@ use varspec::samplers::Sampler;
 use varspec::scene::analysis::{PixelKind, SampleShear};
 use varspec::scene::image::GreyImage;
 use varspec::scene::render::{
-    DEFAULT_PILOTS, PixelStatistics, ShearPolicy, VarianceMaps, analyse, mse_against, pixel_shears,
-    render, render_variance,
+    DEFAULT_PILOTS, MAX_PILOTS, MAX_RENDERS, PixelStatistics, ShearPolicy, VarianceMaps, analyse,
+    mse_against, pilot_estimates, pixel_shears, render, render_variance,
 };
 use varspec::scene::{BUILTIN_SCENES, Scene};
 
@@ -39,15 +39,16 @@ pub struct Args {
     /// everywhere); warp:K (the footprint warp of slope K everywhere).
     #[arg(long, default_value = "none", allow_hyphen_values = true)]
     shear: String,
-    /// Pilot estimates per candidate shear (--shear pilot; at least 2;
+    /// Pilot estimates per candidate shear (--shear pilot; 2 to 2^20;
     /// default 32).
-    #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
+    #[arg(value_parser = super::args::whole_in::<2, { MAX_PILOTS as u64 }, usize>, allow_negative_numbers = true, long)]
     pilots: Option<usize>,
     /// Seed: the same seed gives the same image for any thread count.
     #[arg(value_parser = super::args::whole::<u64>, allow_negative_numbers = true, long, default_value_t = 0)]
     seed: u64,
-    /// Independent renders; 2 or more also give the per-pixel variance.
-    #[arg(value_parser = super::args::whole_at_least::<1, usize>, allow_negative_numbers = true, long, default_value_t = 1)]
+    /// Independent renders (1 to 2^30); 2 or more also give the per-pixel
+    /// variance.
+    #[arg(value_parser = super::args::whole_in::<1, { MAX_RENDERS as u64 }, usize>, allow_negative_numbers = true, long, default_value_t = 1)]
     renders: usize,
     /// Tone-mapped PNG of the (mean) image (default out/render/SCENE.png).
     #[arg(short = 'o', long = "output", value_parser = super::args::png_path)]
@@ -124,9 +125,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if !(a.exposure.is_finite() && a.exposure > 0.0) {
         bail!("--exposure {}: expected a positive number", a.exposure);
     }
-    if a.renders == 0 {
-        bail!("--renders must be at least 1");
-    }
+
     if a.renders < 2
         && (a.variance_png.is_some() || a.variance_pfm.is_some() || a.variance_npy.is_some())
     {
@@ -211,10 +210,28 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             scene.name()
         );
     }
-    warn_slow_sets(sampler.as_ref(), &a.sampler, a.seed, w * h * a.renders)?;
     let start = Instant::now();
     let analysis = analyse(&scene);
-    let shears = pixel_shears(&scene, sampler.as_ref(), policy, &analysis, a.seed)?;
+    let pilots = pilot_estimates(policy, &analysis);
+    warn_slow_sets(
+        sampler.as_ref(),
+        &a.sampler,
+        a.seed,
+        (w * h) as u64 * a.renders as u64,
+        pilots,
+    )?;
+    let edges = analysis
+        .iter()
+        .filter(|p| p.kind == PixelKind::Edge)
+        .count();
+    let pilot_bar = match policy {
+        ShearPolicy::Pilot { .. } => progress::bar(edges as u64, "pilots on edge pixels"),
+        _ => indicatif::ProgressBar::hidden(),
+    };
+    let shears = pixel_shears(&scene, sampler.as_ref(), policy, &analysis, a.seed, &|| {
+        pilot_bar.inc(1)
+    })?;
+    pilot_bar.finish_and_clear();
     let bar = progress::bar(a.renders as u64, &format!("render {}", scene.name()));
     let (image, maps) = if a.renders >= 2 {
         let maps = render_variance(
@@ -419,20 +436,32 @@ fn log_range(text: &str) -> Result<(f64, f64), String> {
     }
 }
 
-/// Draws one set and, when the render's sets would take more than
-/// [`SLOW_DRAWING`] seconds in all, says how long before it starts
-/// (optimized samplers such as blue-noise descend per set: a 4-point 4D set
-/// takes seconds, a 256×256 image hours).
-fn warn_slow_sets(sampler: &dyn Sampler, name: &str, seed: u64, sets: usize) -> anyhow::Result<()> {
+/// Draws one set and, when the render's sets (`sets` for the pixels of
+/// every render, `pilots` for the pilot estimates of `--shear pilot`) would
+/// take more than [`SLOW_DRAWING`] seconds in all, says how long drawing
+/// them takes (optimized samplers such as blue-noise descend per set: a
+/// 4-point 4D set takes seconds, a 256×256 image hours).
+fn warn_slow_sets(
+    sampler: &dyn Sampler,
+    name: &str,
+    seed: u64,
+    sets: u64,
+    pilots: u64,
+) -> anyhow::Result<()> {
     let start = Instant::now();
     sampler.sample(&mut varspec::rng::set_rng(seed, 0))?;
     let one = start.elapsed().as_secs_f64();
     let threads = rayon::current_num_threads();
-    let total = one * sets as f64 / threads as f64;
+    let total = one * (sets + pilots) as f64 / threads as f64;
     if total > SLOW_DRAWING {
+        let pilots = if pilots > 0 {
+            format!(" and {pilots} pilot estimates")
+        } else {
+            String::new()
+        };
         eprintln!(
-            "note: one {} set takes {} to draw; {sets} sets (pixels × renders) on {threads} \
-             thread(s) take about {} before any ray is traced",
+            "note: one {} set takes {} to draw; {sets} sets (pixels × renders){pilots} on \
+             {threads} thread(s) take about {} in drawing alone",
             name,
             if one >= 1.0 {
                 format!("{one:.1} s")

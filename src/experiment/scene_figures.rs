@@ -159,7 +159,7 @@ pub(super) fn scene_variance(
                        policy: ShearPolicy,
                        png: Option<(String, String)>|
          -> Result<(f64, Option<f64>), Box<dyn std::error::Error>> {
-            let shears = pixel_shears(&scene, s, policy, &analysis, seed)?;
+            let shears = pixel_shears(&scene, s, policy, &analysis, seed, &|| {})?;
             let maps = render_variance(&scene, s, &shears, seed, renders, &|| {})?;
             let mse = maps.mse_against(&reference);
             let stats = PixelStatistics::of(&maps.variance.pixels);

@@ -60,13 +60,15 @@ pub enum RenderError {
     /// A sampler failure.
     #[error(transparent)]
     Sampler(#[from] SamplerError),
-    /// Zero renders or pilots.
-    #[error("{what} must be at least {min}")]
+    /// Renders or pilots out of range.
+    #[error("{what} must be at least {min} and at most {max}")]
     Count {
         /// Which count.
         what: &'static str,
         /// Its minimum.
         min: usize,
+        /// Its maximum.
+        max: usize,
     },
 }
 
@@ -76,8 +78,42 @@ fn pixel_stream(render: u64, pixel: usize) -> u64 {
     (render << 32) | pixel as u64
 }
 
-/// First render index of the pilot streams: far from any render count.
+/// First render index of the pilot streams, beyond the last render's
+/// ([`MAX_RENDERS`]); with [`MAX_PILOTS`] the stream stays below 2^32.
 const PILOT_STREAM: u64 = 1 << 30;
+
+/// Renders one request may ask for: render r's streams are its own below
+/// the pilots' ([`PILOT_STREAM`]).
+pub const MAX_RENDERS: usize = 1 << 30;
+
+/// Pilot estimates per candidate one request may ask for (the sample
+/// variance of 2^20 estimates is within 0.3% at 95%; more only costs).
+pub const MAX_PILOTS: usize = 1 << 20;
+
+/// The candidates [`ShearPolicy::Pilot`] tries on an edge pixel: none,
+/// then the position shear and the warp of every depth the probes met.
+fn pilot_candidates(a: &PixelAnalysis) -> impl Iterator<Item = SampleShear> + '_ {
+    std::iter::once(SampleShear::NONE).chain(
+        a.kappas
+            .iter()
+            .filter(|k| k.abs() >= MIN_WARP_SLOPE)
+            .flat_map(|&k| [SampleShear::Position([-k, -k]), SampleShear::Warp(k)]),
+    )
+}
+
+/// The pilot estimates (sets drawn and traced) [`pixel_shears`] makes
+/// under `policy`: `pilots` per candidate of every edge pixel (0 unless
+/// [`ShearPolicy::Pilot`]), for a time estimate before they start.
+pub fn pilot_estimates(policy: ShearPolicy, analysis: &[PixelAnalysis]) -> u64 {
+    match policy {
+        ShearPolicy::Pilot { pilots } => analysis
+            .iter()
+            .filter(|a| a.kind == PixelKind::Edge)
+            .map(|a| pilot_candidates(a).count() as u64 * pilots as u64)
+            .sum(),
+        _ => 0,
+    }
+}
 
 /// The per-pixel analysis of the whole image, row by row from the top.
 pub fn analyse(scene: &Scene) -> Vec<PixelAnalysis> {
@@ -88,16 +124,19 @@ pub fn analyse(scene: &Scene) -> Vec<PixelAnalysis> {
         .collect()
 }
 
-/// The (a, b) of every pixel under `policy`.
+/// The (a, b) of every pixel under `policy`; `progress` is called once per
+/// edge pixel whose pilots are done (never under other policies).
 ///
 /// # Errors
-/// [`RenderError`] from the pilot renders.
+/// [`RenderError`] from the pilot renders; pilots outside [2,
+/// [`MAX_PILOTS`]].
 pub fn pixel_shears(
     scene: &Scene,
     sampler: &dyn Sampler,
     policy: ShearPolicy,
     analysis: &[PixelAnalysis],
     seed: u64,
+    progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<SampleShear>, RenderError> {
     check_sampler(scene, sampler)?;
     let w = scene.camera().resolution()[0];
@@ -106,10 +145,11 @@ pub fn pixel_shears(
         ShearPolicy::Global(s) => Ok(vec![s; analysis.len()]),
         ShearPolicy::Analytic => Ok(analysis.iter().map(PixelAnalysis::shear).collect()),
         ShearPolicy::Pilot { pilots } => {
-            if pilots < 2 {
+            if !(2..=MAX_PILOTS).contains(&pilots) {
                 return Err(RenderError::Count {
                     what: "pilot estimates per candidate",
                     min: 2,
+                    max: MAX_PILOTS,
                 });
             }
             analysis
@@ -120,17 +160,12 @@ pub fn pixel_shears(
                         return Ok(a.shear());
                     }
                     let mut best = (SampleShear::NONE, f64::INFINITY);
-                    let candidates = std::iter::once(SampleShear::NONE).chain(
-                        a.kappas
-                            .iter()
-                            .filter(|k| k.abs() >= MIN_WARP_SLOPE)
-                            .flat_map(|&k| [SampleShear::Position([-k, -k]), SampleShear::Warp(k)]),
-                    );
-                    for shear in candidates {
-                        let mut values = Vec::with_capacity(pilots);
+                    for shear in pilot_candidates(a) {
+                        // One pass, no buffer of `pilots` values.
+                        let mut moments = RunningMoments::default();
                         for p in 0..pilots {
                             let stream = pixel_stream(PILOT_STREAM + p as u64, i);
-                            values.push(estimate(
+                            moments.add(estimate(
                                 scene,
                                 sampler,
                                 shear,
@@ -140,11 +175,11 @@ pub fn pixel_shears(
                                 stream,
                             )?);
                         }
-                        let v = crate::sum::sample_variance(&values);
-                        if v < best.1 {
-                            best = (shear, v);
+                        if moments.variance() < best.1 {
+                            best = (shear, moments.variance());
                         }
                     }
+                    progress();
                     Ok(best.0)
                 })
                 .collect()
@@ -300,10 +335,11 @@ pub fn render_variance(
     renders: usize,
     progress: &dyn Fn(),
 ) -> Result<VarianceMaps, RenderError> {
-    if renders < 2 {
+    if !(2..=MAX_RENDERS).contains(&renders) {
         return Err(RenderError::Count {
             what: "renders for a variance",
             min: 2,
+            max: MAX_RENDERS,
         });
     }
     let [width, height] = scene.camera().resolution();

@@ -748,7 +748,7 @@ fn scene_section(o: &TourOptions) -> Result<SceneSection, TourError> {
         ),
     ] {
         let start = Instant::now();
-        let shears = pixel_shears(&scene, umj.as_ref(), policy, &analysis, o.seed)
+        let shears = pixel_shears(&scene, umj.as_ref(), policy, &analysis, o.seed, &|| {})
             .map_err(at("per-pixel shears"))?;
         let maps = render_variance(&scene, umj.as_ref(), &shears, o.seed, renders, &|| {})
             .map_err(at("rendering"))?;
