@@ -102,9 +102,12 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         ignore_lines: true,
         ..Default::default()
     };
-    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| {
+    let text = obj_text(path)?;
+    // Materials are not read: surfaces take the scene file's.
+    let no_materials = |_: &Path| Err(tobj::LoadError::OpenFileFailed);
+    let parsed = tobj::load_obj_buf(&mut text.as_bytes(), &options, no_materials);
+    let (models, _materials) = parsed.map_err(|e| {
         // tobj's errors do not say where; the line is found again in the text.
-        let text = obj_text(path);
         match obj_error_line(&text, &e) {
             Some((number, line)) => format!(
                 "a Wavefront OBJ file ({} line {number}: {e}: `{}`)",
@@ -121,7 +124,6 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         if let Some(bad) = positions.iter().copied().find(|&v| out_of_range(v)) {
             let expected = format!("finite vertex positions of magnitude at most {MAX_LENGTH:e}");
             // The line, where the value stands as written (a `w` divides it).
-            let text = obj_text(path);
             let line = text.lines().enumerate().find(|(_, l)| {
                 let mut words = l.split_whitespace();
                 words.next() == Some("v")
@@ -182,10 +184,33 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
     Ok(triangles)
 }
 
-/// An OBJ file's text read again to locate an error (read once, only on
-/// the error path; bytes that are not UTF-8 become U+FFFD).
-fn obj_text(path: &Path) -> String {
-    String::from_utf8_lossy(&std::fs::read(path).unwrap_or_default()).into_owned()
+/// An OBJ file's text: UTF-8 (ASCII in practice), a leading byte-order
+/// mark dropped (read as part of the first line, it hid that line's `v` and
+/// every face index then named the next vertex). UTF-16 and bytes that are
+/// not UTF-8 are refused with their line.
+fn obj_text(path: &Path) -> Result<String, String> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| format!("a readable Wavefront OBJ file ({}: {e})", path.display()))?;
+    if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) {
+        return Err(format!(
+            "a Wavefront OBJ file in UTF-8 or ASCII ({} is UTF-16: save it as UTF-8)",
+            path.display()
+        ));
+    }
+    let body = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+    match std::str::from_utf8(body) {
+        Ok(text) => Ok(text.to_owned()),
+        Err(e) => {
+            let line = 1 + body[..e.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            Err(format!(
+                "a Wavefront OBJ file in UTF-8 or ASCII ({} line {line}: bytes that are not UTF-8)",
+                path.display()
+            ))
+        }
+    }
 }
 
 /// The first line of an OBJ text that tobj's `error` is about (1-based, with
