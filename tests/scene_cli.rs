@@ -249,6 +249,19 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
             "\"aperture\": -Infinity",
             "camera.aperture: `-Infinity` is not a JSON value (JSON has no NaN or infinities",
         ),
+        // A name given as another JSON value: serde_json's enum reader calls
+        // it a syntax error ("expected value", which read "`1` is not a JSON
+        // value"); the message says what is wanted and lists the names.
+        (
+            "\"integrand\": \"lens\"",
+            "\"integrand\": 1",
+            "integrand: `1` where a name (a JSON string) is expected: `lens` or `light` at line",
+        ),
+        (
+            "\"shape\": \"quad\"",
+            "\"shape\": [\"quad\"]",
+            "objects[0].shape: an array where a name (a JSON string) is expected: one of `quad`, `box`, `sphere`, `obj`",
+        ),
         // Fields that mean nothing where they stand were read and ignored.
         (
             "\"scale\": [6, 6, 1]",

@@ -52,6 +52,13 @@ pub fn from_json<T: DeserializeOwned>(text: &str) -> Result<T, String> {
         {
             return located;
         }
+        if e.inner().to_string().starts_with("expected value")
+            && !path.is_empty()
+            && text.len() <= LOCATE_LIMIT
+            && let Some(named) = name_expected::<T>(text, path, e.inner())
+        {
+            return format!("{path}: {named}");
+        }
         let message = plain_message(e.inner(), text);
         if path.is_empty() {
             message
@@ -104,6 +111,41 @@ fn field_in_tagged_object<T: DeserializeOwned>(text: &str, path: &str) -> Option
             (error_of(trial).map(|e| e.1) != Some(original.clone()))
                 .then(|| format!("{path}.{key}: {original}"))
         })
+}
+
+/// serde_json's "expected value" in a text that is valid JSON: a name of
+/// an enum (`"integrand": "lens"`) given as a number, array, boolean or
+/// null, which serde_json's enum reader calls a syntax error. The names it
+/// takes come from the error of the same file with an empty string there
+/// ("unknown variant ``, expected `lens` or `light`"). `None` when the
+/// text is not JSON (then the message is right) or the value is not found.
+fn name_expected<T: DeserializeOwned>(
+    text: &str,
+    path: &str,
+    error: &serde_json::Error,
+) -> Option<String> {
+    let mut root: serde_json::Value = serde_json::from_str(text).ok()?;
+    let slot = root.pointer_mut(&json_pointer(path)?)?;
+    let found = match &*slot {
+        serde_json::Value::Array(_) => "an array".to_string(),
+        serde_json::Value::Object(_) | serde_json::Value::String(_) => return None,
+        other => format!("`{other}`"),
+    };
+    *slot = serde_json::Value::String(String::new());
+    let names = serde_path_to_error::deserialize::<_, T>(root)
+        .err()
+        .and_then(|e| {
+            let inner = e.inner().to_string();
+            inner
+                .strip_prefix("unknown variant ``, expected ")
+                .map(|names| format!(": {names}"))
+        })
+        .unwrap_or_default();
+    Some(format!(
+        "{found} where a name (a JSON string) is expected{names} at line {} column {}",
+        error.line(),
+        error.column()
+    ))
 }
 
 /// How serde's "invalid type" and "invalid value" errors may describe a
