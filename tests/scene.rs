@@ -369,6 +369,72 @@ fn a_scene_in_millimetres_renders_as_in_metres() {
     }
 }
 
+/// A scene placed far from the world origin renders as at it: the BVH's
+/// f32 coordinates are relative to the camera (in world coordinates f32
+/// spacing at 1e8 is 8: the dof scene's sphere of radius 0.3 vanished and
+/// its box was distorted). The dof scene (textures, defocus) and the disk
+/// light over a plane (shadow-ray offsets) moved by 1e8 along every axis.
+#[test]
+fn a_scene_far_from_the_origin_renders_as_at_it() {
+    use varspec::scene::analysis::SampleShear;
+    use varspec::scene::render::render;
+    let moved = |text: &str, by: f64| {
+        let mut file: serde_json::Value = serde_json::from_str(text).unwrap();
+        let shift = |v: &mut serde_json::Value| {
+            for c in v.as_array_mut().unwrap() {
+                *c = serde_json::json!(c.as_f64().unwrap() + by);
+            }
+        };
+        file["camera"]["resolution"] = serde_json::json!([16, 16]);
+        shift(&mut file["camera"]["position"]);
+        shift(&mut file["camera"]["look_at"]);
+        for o in file["objects"].as_array_mut().unwrap() {
+            shift(&mut o["translate"]);
+        }
+        if let Some(lights) = file.get_mut("lights").and_then(|l| l.as_array_mut()) {
+            for l in lights {
+                shift(&mut l["centre"]);
+            }
+        }
+        file.to_string()
+    };
+    let disk_light = r#"{
+  "camera": {"resolution": [12, 12], "fov_degrees": 60, "position": [0, 0, 0],
+             "look_at": [0, 0, -1], "focal_distance": 4, "aperture": 0},
+  "integrand": "light", "ambient": 0.0,
+  "objects": [{"shape": "quad", "scale": [20, 20, 1], "translate": [0, 0, -5],
+               "material": {"texture": "constant", "albedo": 0.5}}],
+  "lights": [{"shape": "disk", "centre": [0.3, 0.2, -3], "normal": [0, 0, -1],
+              "size": 1, "radiance": 10.0}]
+}"#;
+    let dof =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/dof.json")).unwrap();
+    let sampler = registry::build("umj", 16, Some(4), &[]).unwrap();
+    for (name, text) in [("dof", dof.as_str()), ("disk light", disk_light)] {
+        let image = |by: f64| {
+            let scene = Scene::from_text(&moved(text, by), name).unwrap();
+            render(
+                &scene,
+                sampler.as_ref(),
+                &vec![SampleShear::NONE; 256],
+                3,
+                0,
+            )
+            .unwrap()
+        };
+        let (here, far) = (image(0.0), image(1e8));
+        let lit = here.pixels.iter().filter(|&&v| v > 0.0).count();
+        assert!(lit > 200, "{name}: only {lit} of 256 pixels lit");
+        for (i, (a, b)) in here.pixels.iter().zip(&far.pixels).enumerate() {
+            // The placements' f64 rounding at 1e8 (1.5e-8) only.
+            assert!(
+                (a - b).abs() <= 1e-6 * a.abs().max(1e-3),
+                "{name} pixel {i}: {a} at the origin, {b} at 1e8"
+            );
+        }
+    }
+}
+
 /// A distant light (a sun 1e5 away) keeps the shadow of an occluder half
 /// a unit above the floor: the shadow ray's offset follows the rounding at
 /// its start, not the light's distance (a first version scaled it by the

@@ -2,7 +2,11 @@
 //! camera rays per second of the CWBVH on this 2-core machine,
 //! results/scene/bench-render.csv) or compressed-wide (CWBVH; Ylitie et al.
 //! 2017): closest hits for camera rays, any hit for shadow rays. Traversal
-//! is f32 (obvhs); hit points are rebuilt in f64 from the ray parameter.
+//! is f32 (obvhs) about the camera: triangles and ray origins are stored
+//! relative to a world point (the camera's position) taken away in f64, so
+//! a scene placed at 1e8 renders as at the origin (in world coordinates f32
+//! spacing there is 8, and a sphere of radius 0.3 vanished); hit points are
+//! rebuilt in f64 world coordinates from the ray parameter.
 
 use std::time::Duration;
 
@@ -191,30 +195,32 @@ enum Tree {
     Binary(Bvh2),
 }
 
-/// Every triangle of a scene in one BVH.
+/// Every triangle of a scene in one BVH, in f32 coordinates relative to
+/// a world point (`origin`).
 pub struct Geometry {
     tree: Tree,
     triangles: Vec<Triangle>,
     object_of: Vec<u32>,
+    origin: [f64; 3],
 }
 
 impl Geometry {
     /// Builds a BVH of the given kind over the objects' triangles:
-    /// `meshes[i]` holds object i's in model space.
+    /// `meshes[i]` holds object i's in model space; `origin` is the world
+    /// point the f32 coordinates are relative to (the camera's position:
+    /// precision is kept where the picture is).
     pub fn build_with(
         objects: &[ObjectFile],
         meshes: &[Vec<ModelTriangle>],
         kind: BvhKind,
+        origin: [f64; 3],
     ) -> Geometry {
         let mut triangles = Vec::new();
         let mut object_of = Vec::new();
         for (i, (o, mesh)) in objects.iter().zip(meshes).enumerate() {
             let place = Placement::of(o);
             for &[a, b, c] in mesh {
-                let v = |p| {
-                    let q = place.apply(p);
-                    Vec3A::new(q[0] as f32, q[1] as f32, q[2] as f32)
-                };
+                let v = |p| relative(place.apply(p), origin);
                 triangles.push(Triangle {
                     v0: v(a),
                     v1: v(b),
@@ -240,6 +246,7 @@ impl Geometry {
             tree,
             triangles,
             object_of,
+            origin,
         }
     }
 
@@ -252,6 +259,12 @@ impl Geometry {
         indices[slot] as usize
     }
 
+    /// The largest coordinate of world point `p` as the f32 traversal sees
+    /// it (relative to the origin), which sets its rounding.
+    pub fn magnitude(&self, p: [f64; 3]) -> f64 {
+        (0..3).fold(0.0, |m: f64, k| m.max((p[k] - self.origin[k]).abs()))
+    }
+
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
@@ -259,7 +272,12 @@ impl Geometry {
 
     /// The closest hit along `origin + t·direction`, t in (t_min, ∞).
     pub fn closest(&self, origin: [f64; 3], direction: [f64; 3], t_min: f64) -> Option<Hit> {
-        let ray = Ray::new(f32v(origin), f32v(direction), t_min as f32, f32::INFINITY);
+        let ray = Ray::new(
+            relative(origin, self.origin),
+            f32v(direction),
+            t_min as f32,
+            f32::INFINITY,
+        );
         let mut hit = RayHit::none();
         let intersect =
             |ray: &Ray, slot: usize| self.triangles[self.primitive(slot)].intersect(ray);
@@ -295,7 +313,12 @@ impl Geometry {
     /// off the surfaces at its ends: an origin offset along the normal, a
     /// length stopping short of the light.
     pub fn unoccluded(&self, origin: [f64; 3], direction: [f64; 3], length: f64) -> bool {
-        let ray = Ray::new(f32v(origin), f32v(direction), 0.0, length as f32);
+        let ray = Ray::new(
+            relative(origin, self.origin),
+            f32v(direction),
+            0.0,
+            length as f32,
+        );
         let intersect =
             |ray: &Ray, slot: usize| self.triangles[self.primitive(slot)].intersect(ray);
         match &self.tree {
@@ -307,6 +330,11 @@ impl Geometry {
 
 fn f32v(p: [f64; 3]) -> Vec3A {
     Vec3A::new(p[0] as f32, p[1] as f32, p[2] as f32)
+}
+
+/// `p − origin` in f64, then rounded to f32.
+fn relative(p: [f64; 3], origin: [f64; 3]) -> Vec3A {
+    f32v(std::array::from_fn(|k| p[k] - origin[k]))
 }
 
 pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -153,13 +153,13 @@ const RAY_EPSILON: f64 = 1e-4;
 /// scaled by 1000 rendered its lit pixels 4–9% too dark).
 const RAY_EPSILON_ULPS: f64 = 64.0;
 
-/// The offset of a shadow ray leaving `point`, whose position came from a
-/// camera ray of reach `reach` (|origin|∞ + t): the rounding is at the
-/// ray's start, whatever the light's distance (a light's coordinates in the
-/// scale would let a distant sun's shadow rays skip nearby occluders).
-fn ray_offset(point: [f64; 3], reach: f64) -> f64 {
-    let scale = point.iter().fold(reach, |m, c| m.max(c.abs()));
-    RAY_EPSILON.max(RAY_EPSILON_ULPS * f64::from(f32::EPSILON) * scale)
+/// The offset of a shadow ray leaving a point of f32 magnitude `point`
+/// ([`Geometry::magnitude`]), whose position came from a camera ray of
+/// reach `reach` (its origin's magnitude + t): the rounding is at the ray's
+/// start, whatever the light's distance (a light's coordinates in the scale
+/// would let a distant sun's shadow rays skip nearby occluders).
+fn ray_offset(point: f64, reach: f64) -> f64 {
+    RAY_EPSILON.max(RAY_EPSILON_ULPS * f64::from(f32::EPSILON) * point.max(reach))
 }
 
 /// The largest scene file read (its meshes are OBJ files of their own).
@@ -255,7 +255,7 @@ impl Scene {
         Ok(Scene {
             name: name.into(),
             camera: Camera::new(&file.camera),
-            geometry: Geometry::build_with(&file.objects, &meshes, bvh),
+            geometry: Geometry::build_with(&file.objects, &meshes, bvh, file.camera.position),
             placements: file.objects.iter().map(Placement::of).collect(),
             lights: file.lights.iter().map(Light::new).collect(),
             file,
@@ -314,7 +314,7 @@ impl Scene {
             return self.file.ambient;
         };
         let albedo = self.albedo(hit.object, hit.point);
-        let reach = ray.origin.iter().fold(0.0_f64, |m, c| m.max(c.abs())) + hit.t;
+        let reach = self.geometry.magnitude(ray.origin) + hit.t;
         let mut irradiance = self.file.ambient;
         for light in &self.lights {
             let (at, area) = if lens {
@@ -352,7 +352,7 @@ impl Scene {
         // Leave the surface by the offset along its normal and stop that
         // far short of the light: once at each end (the segment used to
         // skip it twice at each, missing occluders within 2·eps).
-        let eps = ray_offset(point, reach);
+        let eps = ray_offset(self.geometry.magnitude(point), reach);
         let origin: [f64; 3] = std::array::from_fn(|k| point[k] + eps * normal[k]);
         let span = description::sub(at, origin);
         let length = dot(span, span).sqrt();
