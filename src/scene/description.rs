@@ -317,7 +317,7 @@ pub enum SceneError {
         expected: String,
     },
     /// No built-in scene and no file of that name.
-    #[error("no scene `{name}`{suggestion}: neither a built-in scene ({known}) nor a file")]
+    #[error("no scene `{name}`{suggestion}: neither a built-in scene ({known}) nor a file{place}")]
     Unknown {
         /// The name given.
         name: String,
@@ -325,6 +325,9 @@ pub enum SceneError {
         suggestion: String,
         /// The built-in names.
         known: String,
+        /// Where a relative path was looked for (" in the working
+        /// directory /…"), or empty.
+        place: String,
     },
 }
 

@@ -183,6 +183,14 @@ impl Scene {
                     BUILTIN_SCENES.iter().map(|s| s.0),
                 ),
                 known: BUILTIN_SCENES.map(|s| s.0).join(", "),
+                // Relative paths (also in experiment files) are read from
+                // the working directory, not the naming file's folder.
+                place: match std::env::current_dir() {
+                    Ok(dir) if std::path::Path::new(name_or_path).is_relative() => {
+                        format!(" in the working directory {}", dir.display())
+                    }
+                    _ => String::new(),
+                },
             });
         }
         let text = crate::io::read_text_bounded(path, MAX_SCENE_BYTES, "a scene file").map_err(

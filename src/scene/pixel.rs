@@ -137,10 +137,15 @@ impl PixelIntegrand {
                 return Err(fail(format!("`{key}` given twice")));
             }
             let v: usize = value.parse().map_err(|_| {
-                fail(format!(
-                    "{key} = {value}: a pixel index is written in digits, counted from 0 \
-                     (px from the left, py from the top)"
-                ))
+                let digits = !value.is_empty() && value.bytes().all(|b| b.is_ascii_digit());
+                fail(if digits {
+                    format!("{key} = {value}: beyond any image (more than 2^64 pixels across)")
+                } else {
+                    format!(
+                        "{key} = {value}: a pixel index is written in digits, counted from 0 \
+                         (px from the left, py from the top)"
+                    )
+                })
             })?;
             *slot = Some(v);
         }
