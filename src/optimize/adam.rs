@@ -98,6 +98,9 @@ pub enum Stop {
     Floor,
     /// The iteration cap came first: not converged by the rule.
     Cap,
+    /// No step can change the loss: one point on the torus, whose
+    /// spectrum |S(k)|² = 1 at every k wherever it lies.
+    Stationary,
 }
 
 impl Stop {
@@ -107,6 +110,7 @@ impl Stop {
             Stop::Converged => "converged",
             Stop::Floor => "at the transform's accuracy floor",
             Stop::Cap => "iteration cap, not converged",
+            Stop::Stationary => "one point: its loss is the same wherever it lies",
         }
     }
 }

@@ -61,9 +61,14 @@ impl Kept {
         }
     }
 
-    /// True when the returned set is the start: the exact form kept it, or
-    /// (without one) the descent's best score is the start's.
+    /// True when a descent ran and returned its start: the exact form kept
+    /// it, or (without one) the descent's best score is the start's. False
+    /// for one point on the torus, where no descent runs
+    /// ([`super::adam::Stop::Stationary`]).
     pub fn start_returned(&self) -> bool {
+        if self.descent.stop == super::adam::Stop::Stationary {
+            return false;
+        }
         match self.exact {
             Some(e) => e.kept_start,
             None => self.descent.best_score >= self.descent.start_score,
