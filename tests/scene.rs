@@ -710,6 +710,46 @@ fn bad_obj_meshes_are_refused_naming_the_field() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A byte-order mark before an OBJ's first line is dropped (read as part
+/// of that line it hid the first `v`, and every face then named the next
+/// vertex: a wrong mesh without an error); material lines are not read;
+/// UTF-16 and bytes that are not UTF-8 are refused with their line.
+#[test]
+fn obj_text_encodings_are_read_or_refused_by_line() {
+    use varspec::scene::mesh::read_obj;
+    let dir = crate::common::temp_dir("obj-encodings");
+    let plain = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv 50 50 50\nf 1 2 3\n";
+    let write = |name: &str, bytes: &[u8]| {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        path
+    };
+    let read = read_obj(&write("plain.obj", plain.as_bytes())).unwrap();
+    assert_eq!(read[0][0], [-1.0, -1.0, 0.0], "{read:?}");
+    let with_bom = [b"\xEF\xBB\xBF".as_slice(), plain.as_bytes()].concat();
+    assert_eq!(read_obj(&write("bom.obj", &with_bom)).unwrap(), read);
+    // Surfaces take the scene file's material: a `usemtl` without a name,
+    // or before a tab, failed tobj's parse ("material parse error").
+    let materials = format!("mtllib nosuch.mtl\nusemtl\n{plain}usemtl\tred\n");
+    assert_eq!(
+        read_obj(&write("materials.obj", materials.as_bytes())).unwrap(),
+        read
+    );
+    let utf16: Vec<u8> = [0xFF, 0xFE]
+        .into_iter()
+        .chain(plain.encode_utf16().flat_map(u16::to_le_bytes))
+        .collect();
+    let refused = read_obj(&write("wide.obj", &utf16)).unwrap_err();
+    assert!(refused.contains("wide.obj is UTF-16"), "{refused}");
+    let latin1 = b"v 0 0 0\nv 1 0 0\n# caf\xE9\nv 0 1 0\nf 1 2 3\n";
+    let refused = read_obj(&write("latin1.obj", latin1)).unwrap_err();
+    assert!(
+        refused.contains("latin1.obj line 3: bytes that are not UTF-8"),
+        "{refused}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn a_pixel_as_an_integrand_has_its_closed_form_integral_and_variance() {
     use std::sync::Arc;

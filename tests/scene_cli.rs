@@ -252,10 +252,13 @@ fn bad_scenes_and_requests_are_refused_with_the_field_named() {
         // A name given as another JSON value: serde_json's enum reader calls
         // it a syntax error ("expected value", which read "`1` is not a JSON
         // value"); the message says what is wanted and lists the names.
+        // The names come from the text with `""` there, so a wrong field
+        // later in the file (`ambient`, before `integrand` in a sorted map)
+        // does not hide them.
         (
-            "\"integrand\": \"lens\"",
-            "\"integrand\": 1",
-            "integrand: `1` where a name (a JSON string) is expected: `lens` or `light` at line",
+            "\"integrand\": \"lens\",\n  \"ambient\": 1.0",
+            "\"integrand\": 1e3,\n  \"ambient\": \"x\"",
+            "integrand: `1e3` where a name (a JSON string) is expected: `lens` or `light` at line",
         ),
         (
             "\"shape\": \"quad\"",

@@ -212,6 +212,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     }
     let start = Instant::now();
     let analysis = analyse(&scene);
+    let analysed = start.elapsed();
     let pilots = pilot_estimates(policy, &analysis);
     warn_slow_sets(
         sampler.as_ref(),
@@ -220,6 +221,8 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         (w * h) as u64 * a.renders as u64,
         pilots,
     )?;
+    // The render's time counts the analysis, not the probe draw above.
+    let start = Instant::now().checked_sub(analysed).unwrap_or(start);
     let edges = analysis
         .iter()
         .filter(|p| p.kind == PixelKind::Edge)

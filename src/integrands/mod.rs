@@ -49,6 +49,7 @@ pub trait Integrand: Send + Sync {
     /// rounding of x + s (a spread of 1e-4 turn between points whose exact
     /// phases agree), so it reduces the phases of x and s apart.
     fn eval_shifted(&self, x: &[f64], s: &[f64]) -> f64 {
+        debug_assert!(x.len() <= 4 && s.len() == x.len(), "a point and its shift");
         let mut y = [0.0; 4];
         for ((yj, a), b) in y.iter_mut().zip(x).zip(s) {
             let v = a + b;

@@ -116,29 +116,46 @@ fn field_in_tagged_object<T: DeserializeOwned>(text: &str, path: &str) -> Option
 /// serde_json's "expected value" in a text that is valid JSON: a name of
 /// an enum (`"integrand": "lens"`) given as a number, array, boolean or
 /// null, which serde_json's enum reader calls a syntax error. The names it
-/// takes come from the error of the same file with an empty string there
-/// ("unknown variant ``, expected `lens` or `light`"). `None` when the
-/// text is not JSON (then the message is right) or the value is not found.
+/// takes come from the error of the same text with `""` in that value's
+/// place ("unknown variant ``, expected `lens` or `light`"; the text, not
+/// a parsed map, so no other field is read first). `None` when the text is
+/// not JSON (then the message is right) or no value starts there.
 fn name_expected<T: DeserializeOwned>(
     text: &str,
     path: &str,
     error: &serde_json::Error,
 ) -> Option<String> {
-    let mut root: serde_json::Value = serde_json::from_str(text).ok()?;
-    let slot = root.pointer_mut(&json_pointer(path)?)?;
-    let found = match &*slot {
+    serde_json::from_str::<serde_json::Value>(text).ok()?;
+    // The error's 1-based line and byte column as a byte offset.
+    let line_start: usize = text
+        .split_inclusive('\n')
+        .take(error.line().saturating_sub(1))
+        .map(str::len)
+        .sum();
+    let at = line_start + error.column().saturating_sub(1);
+    let rest = text.get(at..)?;
+    let mut values = serde_json::Deserializer::from_str(rest).into_iter::<serde_json::Value>();
+    let value = values.next()?.ok()?;
+    let (written, after) = rest.split_at(values.byte_offset());
+    let found = match value {
         serde_json::Value::Array(_) => "an array".to_string(),
         serde_json::Value::Object(_) | serde_json::Value::String(_) => return None,
-        other => format!("`{other}`"),
+        _ => format!("`{}`", written.trim()),
     };
-    *slot = serde_json::Value::String(String::new());
-    let names = serde_path_to_error::deserialize::<_, T>(root)
+    let replaced = format!("{}\"\"{after}", &text[..at]);
+    let mut de = serde_json::Deserializer::from_str(&replaced);
+    let names = serde_path_to_error::deserialize::<_, T>(&mut de)
         .err()
         .and_then(|e| {
             let inner = e.inner().to_string();
-            inner
-                .strip_prefix("unknown variant ``, expected ")
-                .map(|names| format!(": {names}"))
+            (e.path().to_string() == path)
+                .then(|| {
+                    inner
+                        .strip_prefix("unknown variant ``, expected ")
+                        .and_then(|names| names.split(" at line ").next())
+                        .map(|names| format!(": {names}"))
+                })
+                .flatten()
         })
         .unwrap_or_default();
     Some(format!(

@@ -103,7 +103,17 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         ..Default::default()
     };
     let text = obj_text(path)?;
-    // Materials are not read: surfaces take the scene file's.
+    // Materials are not read: surfaces take the scene file's. Their lines
+    // are blanked (numbering kept): a `usemtl` without a name or before a
+    // tab fails tobj's parse, and without materials none splits a model.
+    let text: String = text
+        .lines()
+        .map(|line| match line.split_whitespace().next() {
+            Some("usemtl" | "mtllib") => "",
+            _ => line,
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
     let no_materials = |_: &Path| Err(tobj::LoadError::OpenFileFailed);
     let parsed = tobj::load_obj_buf(&mut text.as_bytes(), &options, no_materials);
     let (models, _materials) = parsed.map_err(|e| {
@@ -219,7 +229,8 @@ fn obj_text(path: &Path) -> Result<String, String> {
 /// that does not, or a face index past the vertices, coordinates or normals.
 /// tobj checks a relative index against those before its face, and the
 /// others when it closes the face's model (at the next `g` or `o` line after
-/// faces, or the end of the file) against those read by then.
+/// faces, or the end of the file) against those read by then; `usemtl`
+/// closes none (its lines are blanked: no materials are read).
 /// `None` for other errors, or where the text shows none.
 fn obj_error_line<'a>(text: &'a str, error: &tobj::LoadError) -> Option<(usize, &'a str)> {
     use tobj::LoadError as E;
