@@ -125,7 +125,6 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     if !(a.exposure.is_finite() && a.exposure > 0.0) {
         bail!("--exposure {}: expected a positive number", a.exposure);
     }
-
     if a.renders < 2
         && (a.variance_png.is_some() || a.variance_pfm.is_some() || a.variance_npy.is_some())
     {
