@@ -103,17 +103,6 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
         ..Default::default()
     };
     let text = obj_text(path)?;
-    // Materials are not read: surfaces take the scene file's. Their lines
-    // are blanked (numbering kept): a `usemtl` without a name or before a
-    // tab fails tobj's parse, and without materials none splits a model.
-    let text: String = text
-        .lines()
-        .map(|line| match line.split_whitespace().next() {
-            Some("usemtl" | "mtllib") => "",
-            _ => line,
-        })
-        .collect::<Vec<_>>()
-        .join("\n");
     let no_materials = |_: &Path| Err(tobj::LoadError::OpenFileFailed);
     let parsed = tobj::load_obj_buf(&mut text.as_bytes(), &options, no_materials);
     let (models, _materials) = parsed.map_err(|e| {
@@ -194,10 +183,13 @@ pub fn read_obj(path: &Path) -> Result<Vec<ModelTriangle>, String> {
     Ok(triangles)
 }
 
-/// An OBJ file's text: UTF-8 (ASCII in practice), a leading byte-order
-/// mark dropped (read as part of the first line, it hid that line's `v` and
-/// every face index then named the next vertex). UTF-16 and bytes that are
-/// not UTF-8 are refused with their line.
+/// An OBJ file's text as tobj reads it: UTF-8 (ASCII in practice), a
+/// leading byte-order mark dropped (read as part of the first line, it hid
+/// that line's `v` and every face index then named the next vertex), and
+/// material lines blanked with the numbering kept (surfaces take the scene
+/// file's material; a `usemtl` without a name or before a tab fails tobj's
+/// parse, and without materials none splits a model). UTF-16 and bytes that
+/// are not UTF-8 are refused with their line.
 fn obj_text(path: &Path) -> Result<String, String> {
     let bytes = std::fs::read(path)
         .map_err(|e| format!("a readable Wavefront OBJ file ({}: {e})", path.display()))?;
@@ -207,9 +199,18 @@ fn obj_text(path: &Path) -> Result<String, String> {
             path.display()
         ));
     }
-    let body = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+    let body = bytes
+        .strip_prefix(crate::io::bounded::BOM)
+        .unwrap_or(&bytes);
     match std::str::from_utf8(body) {
-        Ok(text) => Ok(text.to_owned()),
+        Ok(text) => Ok(text
+            .lines()
+            .map(|line| match line.split_whitespace().next() {
+                Some("usemtl" | "mtllib") => "",
+                _ => line,
+            })
+            .collect::<Vec<_>>()
+            .join("\n")),
         Err(e) => {
             let line = 1 + body[..e.valid_up_to()]
                 .iter()
