@@ -213,7 +213,7 @@ pub const SAMPLERS: &[SamplerInfo] = &[
             ParamInfo {
                 key: "max-trials",
                 default: "auto",
-                help: "dart throws before giving up; auto = max(10^7, 1000 N)",
+                help: "dart throws before giving up (a torus with no room left is reported at once); auto = max(10^7, 1000 N)",
             },
         ],
         build: poisson_disk::from_config,

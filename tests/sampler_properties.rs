@@ -205,10 +205,8 @@ fn every_registered_sampler_stays_on_the_torus() {
 
 #[test]
 fn poisson_disk_reports_jamming_instead_of_looping() {
-    let params = [
-        ("radius".to_string(), "0.95".to_string()),
-        ("max-trials".to_string(), "100000".to_string()),
-    ];
+    // Out of throws before the set is full.
+    let params = [("max-trials".to_string(), "300".to_string())];
     let sampler = registry::build("poisson-disk", 500, Some(2), &params).unwrap();
     let err = sampler.sample(&mut set_rng(1, 0)).unwrap_err();
     let text = err.to_string();
@@ -217,7 +215,7 @@ fn poisson_disk_reports_jamming_instead_of_looping() {
             err,
             samplers::SamplerError::Jammed {
                 n: 500,
-                trials: 100000,
+                trials: 300,
                 ..
             }
         ),
@@ -225,6 +223,23 @@ fn poisson_disk_reports_jamming_instead_of_looping() {
     );
     assert!(
         text.contains("of 500 points") && text.contains("radius"),
+        "{text}"
+    );
+    // Beyond the jamming radius, with throws to spare: the torus fills up
+    // and the sampler says so (it threw darts for as long as allowed).
+    let params = [
+        ("radius".to_string(), "0.95".to_string()),
+        ("max-trials".to_string(), "1000000000000000".to_string()),
+    ];
+    let sampler = registry::build("poisson-disk", 500, Some(2), &params).unwrap();
+    let err = sampler.sample(&mut set_rng(1, 0)).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        matches!(err, samplers::SamplerError::Saturated { n: 500, placed, next, .. } if next == placed + 1 && placed < 500),
+        "{text}"
+    );
+    assert!(
+        text.contains("no room for point") && text.contains("radius=..."),
         "{text}"
     );
 }
