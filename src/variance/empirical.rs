@@ -9,6 +9,8 @@
 //! be badly off). Below 8 realizations, where no kurtosis can be estimated,
 //! the interval is the χ² one of normal estimates ([`chi_square_interval`]).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 
 use super::VarianceError;
@@ -103,8 +105,22 @@ where
     VarianceError: From<E>,
     E: Send,
 {
-    let values = shifted_estimates(f, realizations, seed, shift_dims, realization)?;
-    Ok(EmpiricalEstimate::of(&values))
+    let counted = AtomicBool::new(false);
+    let values = estimates(f, realizations, seed, shift_dims, |r| {
+        let set = realization(r)?;
+        if set.borrow().density().is_some() {
+            counted.store(true, Ordering::Relaxed);
+        }
+        Ok(set)
+    })?;
+    // Sets of a random count are weighed by 1/λ, not 1/N: a file's sets
+    // whose mean count is not λ make Î biased, and the spatial and Fourier
+    // forms give the mean squared error about I, bias included.
+    Ok(if counted.into_inner() {
+        EmpiricalEstimate::about(&values, f.integral())
+    } else {
+        EmpiricalEstimate::of(&values)
+    })
 }
 
 /// The estimates Î of the R realizations behind [`empirical_shifting`], in
@@ -127,6 +143,18 @@ where
     VarianceError: From<E>,
     E: Send,
 {
+    estimates(f, realizations, seed, shift_dims, |r| {
+        realization(r).map_err(VarianceError::from)
+    })
+}
+
+fn estimates<P: std::borrow::Borrow<PointSet>>(
+    f: &dyn Integrand,
+    realizations: usize,
+    seed: u64,
+    shift_dims: &[usize],
+    realization: impl Fn(usize) -> Result<P, VarianceError> + Sync,
+) -> Result<Vec<f64>, VarianceError> {
     if let Some(&j) = shift_dims.iter().find(|&&j| j >= f.dim()) {
         return Err(VarianceError::Dimension {
             integrand: f.dim(),
@@ -207,6 +235,49 @@ impl EmpiricalEstimate {
         EmpiricalEstimate {
             variance,
             stderr: var_of_var.sqrt(),
+            ci_low,
+            ci_high,
+            mean,
+            realizations,
+        }
+    }
+}
+
+impl EmpiricalEstimate {
+    /// The statistics of R ≥ 2 estimates Î about the integral I, for an
+    /// estimator that may be biased (sets of a random count weighed by
+    /// 1/λ, whose mean count is not λ): the mean squared error
+    /// (1/R)·Σ(Î − I)² (unbiased: no mean is estimated), its standard
+    /// error from the spread of the squares, and the 95% interval on the
+    /// log scale, ln(c·mse) ± z·c·√((γ̂ − 1)/R) with c = R/(R − z) and
+    /// γ̂ = R·Σ(Î − I)⁴ / (Σ(Î − I)²)² (the delta method for a mean of
+    /// squares with Bonett's small-sample factor c; below 7 realizations
+    /// the χ²_R interval of normal estimates).
+    #[must_use]
+    pub fn about(values: &[f64], integral: f64) -> EmpiricalEstimate {
+        let realizations = values.len();
+        let r = realizations as f64;
+        let mean = sum(values.iter().copied()) / r;
+        let squares: Vec<f64> = values.iter().map(|v| (v - integral).powi(2)).collect();
+        let mse = sum(squares.iter().copied()) / r;
+        let spread = sum(squares.iter().map(|q| (q - mse).powi(2))) / (r - 1.0);
+        let (ci_low, ci_high) = if mse > 0.0 {
+            if realizations >= 7 {
+                let kurtosis = r * sum(squares.iter().map(|q| q * q)) / (mse * r).powi(2);
+                let c = r / (r - NORMAL_95);
+                let half = NORMAL_95 * c * ((kurtosis - 1.0).max(0.0) / r).sqrt();
+                let centre = (c * mse).ln();
+                ((centre - half).exp(), (centre + half).exp())
+            } else {
+                // χ²_R: chi_square_interval's table is indexed by R − 1.
+                chi_square_interval(mse, realizations + 1).unwrap_or((0.0, f64::INFINITY))
+            }
+        } else {
+            (0.0, f64::INFINITY)
+        };
+        EmpiricalEstimate {
+            variance: mse,
+            stderr: (spread / r).sqrt(),
             ci_low,
             ci_high,
             mean,
@@ -300,6 +371,39 @@ mod tests {
             assert!(
                 (coverage - 0.95).abs() <= 0.0134,
                 "R = {r}: coverage {coverage} of the nominal 95% (99.99% band 0.9366-0.9634)"
+            );
+        }
+    }
+
+    /// The interval about a known I keeps its coverage whether Î is
+    /// biased or not: normal estimates of mean I + b, variance 1, so the
+    /// mean squared error is 1 + b². 2000 trials per case (fixed seed): a
+    /// true 95% leaves the observed coverage within ±0.0160 (3.29 standard
+    /// errors, 99.9%), at R = 3 (the χ²_R interval) and R = 50, 2000.
+    #[test]
+    fn the_error_about_i_keeps_its_coverage() {
+        let mut rng = set_rng(0xb1a5, 2);
+        for (r, bias) in [(3, 0.0), (3, 0.5), (50, 0.0), (50, 0.5), (2000, 0.5)] {
+            let trials = 2000;
+            let mse = 1.0 + bias * bias;
+            let covered = (0..trials)
+                .filter(|_| {
+                    let values: Vec<f64> = (0..r)
+                        .map(|_| {
+                            let (u, v) = (uniform(&mut rng), uniform(&mut rng));
+                            let z =
+                                (-2.0 * (1.0 - u).ln()).sqrt() * (std::f64::consts::TAU * v).cos();
+                            7.0 + bias + z
+                        })
+                        .collect();
+                    let e = EmpiricalEstimate::about(&values, 7.0);
+                    e.ci_low <= mse && mse <= e.ci_high
+                })
+                .count();
+            let coverage = covered as f64 / trials as f64;
+            assert!(
+                (coverage - 0.95).abs() <= 0.016,
+                "R = {r}, bias {bias}: coverage {coverage} of the nominal 95% (99.9% band 0.934-0.966)"
             );
         }
     }
