@@ -229,3 +229,37 @@ fn one_point_on_the_torus_is_stationary() {
     assert!((loss - jitter).abs() <= 1e-6 * jitter, "{loss} vs {jitter}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// An output named as the weight table a torus target reads is refused,
+/// `+` in the name included (the guard once split the target at `+`, as a
+/// square target's terms are split, and let the table be overwritten).
+#[test]
+fn an_output_is_never_the_weight_table_read() {
+    let dir = common::temp_dir("table-clash");
+    let table = dir.join("w+1.csv");
+    std::fs::write(&table, "k,weight\n0,1\n1000,1\n").unwrap();
+    let spec = format!("radial:{}", table.display());
+    let out = common::varspec(&[
+        "optimize",
+        "points",
+        "-n",
+        "16",
+        "--sets",
+        "1",
+        "--iters",
+        "2",
+        "--target",
+        &spec,
+        "-o",
+        table.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("both an input and an output"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&table).unwrap(),
+        "k,weight\n0,1\n1000,1\n"
+    );
+}

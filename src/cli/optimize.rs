@@ -195,9 +195,15 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
             a.curve.as_deref(),
             a.curve_png.as_deref(),
         ],
-        varspec::optimize::target::files_read(&a.target)
-            .into_iter()
-            .map(Some),
+        varspec::optimize::target::files_read(
+            &a.target,
+            match a.domain {
+                DomainArg::Torus => varspec::optimize::adam::Domain::Torus,
+                DomainArg::Square => varspec::optimize::adam::Domain::Square,
+            },
+        )
+        .into_iter()
+        .map(Some),
     )?;
     varspec::memory::check(
         &format!(

@@ -243,19 +243,26 @@ fn read_radial(path: &Path) -> Result<Vec<(f64, f64)>, String> {
     Ok(table.into_iter().map(|(k, w)| (k, w / largest)).collect())
 }
 
-/// The files a target spec of `optimize points` reads, whatever its
-/// domain: `radial:FILE` (a torus target, or a projection's
-/// `xu:radial:FILE` between `;`, see [`crate::optimize::projections`]) and
-/// a square family's `file:PATH` (a term between `+`, after an optional
-/// `W*`, see [`crate::square::design::parse_target`]). Callers keep their
-/// outputs off these files.
-pub fn files_read(spec: &str) -> Vec<&Path> {
-    spec.split([';', '+'])
+/// The files a target spec of `optimize points` reads on `domain`, split
+/// as its parser splits it: on the torus `radial:FILE` (the whole target,
+/// or a projection's `xu:radial:FILE` between `;`, see
+/// [`crate::optimize::projections`]: a `+` belongs to the file name); on
+/// the square a family's `file:PATH` (a term between `+`, after an
+/// optional `W*`, see [`crate::square::design::parse_target`]). Callers
+/// keep their outputs off these files.
+pub fn files_read(spec: &str, domain: crate::optimize::adam::Domain) -> Vec<&Path> {
+    use crate::optimize::adam::Domain;
+    let (separator, prefix) = match domain {
+        Domain::Torus => (';', "radial:"),
+        Domain::Square => ('+', "file:"),
+    };
+    spec.split(separator)
         .filter_map(|part| {
-            let part = part.split_once('*').map_or(part, |(_, family)| family);
-            ["radial:", "file:"]
-                .iter()
-                .find_map(|prefix| part.find(prefix).map(|at| &part[at + prefix.len()..]))
+            let part = match domain {
+                Domain::Square => part.split_once('*').map_or(part, |(_, family)| family),
+                Domain::Torus => part,
+            };
+            part.find(prefix).map(|at| &part[at + prefix.len()..])
         })
         .map(|path| Path::new(path.trim()))
         .collect()
@@ -267,17 +274,21 @@ mod tests {
 
     #[test]
     fn the_files_a_target_reads_in_every_grammar() {
-        for (spec, files) in [
-            ("family:disks", vec![]),
-            ("radial:w.csv", vec!["w.csv"]),
+        use crate::optimize::adam::Domain::{Square, Torus};
+        for (spec, domain, files) in [
+            ("family:disks", Torus, vec![]),
+            ("radial:w.csv", Torus, vec!["w.csv"]),
+            // A `+` in a torus target's file name is part of it.
+            ("radial:w+1.csv", Torus, vec!["w+1.csv"]),
             (
-                "xu:radial:a.csv;yv:power:3;uv:radial:b.csv",
-                vec!["a.csv", "b.csv"],
+                "xu:radial:a+b.csv;yv:power:3;uv:radial:b.csv",
+                Torus,
+                vec!["a+b.csv", "b.csv"],
             ),
-            ("halfplanes+2*file:m.txt+16*blue", vec!["m.txt"]),
-            ("disk:r=0.3", vec![]),
+            ("halfplanes+2*file:m.txt+16*blue", Square, vec!["m.txt"]),
+            ("disk:r=0.3", Torus, vec![]),
         ] {
-            let found: Vec<&str> = files_read(spec)
+            let found: Vec<&str> = files_read(spec, domain)
                 .iter()
                 .map(|p| p.to_str().unwrap())
                 .collect();
