@@ -702,3 +702,62 @@ fn the_objective_says_which_half_is_estimated() {
         assert!(description.contains(said), "{sampler}: {description}");
     }
 }
+
+/// A padded half with several parameters is given with --param (the
+/// shorthand splits at every comma, and the error says so): the sampler
+/// built and named is the one asked for, in `optimize shear` and as the
+/// start of `optimize points`.
+#[test]
+fn nested_sampler_specs_go_through_param() {
+    let half = "uv=poisson-disk:radius=0.6,max-trials=100000";
+    let out = crate::common::varspec_ok(&[
+        "optimize",
+        "shear",
+        "-n",
+        "16",
+        "--sampler",
+        "padded",
+        "--param",
+        "xy=cmj",
+        "--param",
+        half,
+        "--integrand",
+        "defocus:c=0.5",
+        "--realizations",
+        "0",
+        "--json",
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        json["sampler"],
+        format!("padded:xy=cmj,{half}"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let dir = crate::common::temp_dir("nested-init");
+    let report = dir.join("r.json");
+    crate::common::varspec_ok(&[
+        "optimize",
+        "points",
+        "-n",
+        "16",
+        "-d",
+        "4",
+        "--init",
+        "padded",
+        "--param",
+        half,
+        "--target",
+        "xu:family:disks",
+        "--sets",
+        "1",
+        "--iters",
+        "2",
+        "-o",
+        dir.join("p.csv").to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+    ]);
+    let r = crate::common::read_json(&report);
+    assert_eq!(r["init"], format!("padded:{half}"), "{r}");
+}

@@ -32,6 +32,11 @@ pub struct ShearArgs {
     /// Padded 4D sampler to shear: umj, or padded:xy=SAMPLER,uv=SAMPLER.
     #[arg(long, default_value = "umj")]
     sampler: String,
+    /// Sampler parameter key=value (repeatable; see `varspec sample
+    /// --list`; wins over the same key in the shorthand; a nested spec with
+    /// commas goes here: --param 'uv=poisson-disk:radius=0.6,max-trials=1000000').
+    #[arg(long = "param", value_parser = super::args::key_value)]
+    params: Vec<(String, String)>,
     /// Points per set.
     #[arg(short = 'n', long = "n", value_parser = super::args::count, allow_negative_numbers = true)]
     n: usize,
@@ -101,6 +106,11 @@ pub struct PointsArgs {
     /// The same as --init (the sampler, as in every other command).
     #[arg(long = "sampler", value_name = "SAMPLER", conflicts_with = "init")]
     sampler_flag: Option<String>,
+    /// Parameter of the starting sampler, key=value (repeatable; see
+    /// `varspec sample --list`; wins over the same key in the shorthand;
+    /// a nested spec with commas goes here: --param 'uv=poisson-disk:radius=0.6,max-trials=1000000').
+    #[arg(long = "param", value_parser = super::args::key_value)]
+    params: Vec<(String, String)>,
     /// Square: family members the result and the classic samplers are scored
     /// on (at least 2, for the standard error) [default: 1024].
     #[arg(value_parser = super::args::whole_at_least::<2, usize>, allow_negative_numbers = true, long)]
@@ -299,6 +309,7 @@ fn points(mut a: PointsArgs) -> anyhow::Result<()> {
         iters: a.iters,
         seed: a.seed,
         init: a.init.clone(),
+        init_params: a.params.clone(),
         tol: a.tol,
         rel_tol: a.rel_tol,
         upsampling: match a.upsampling {
@@ -510,6 +521,7 @@ fn points_projections(a: PointsArgs) -> anyhow::Result<()> {
         rel_tol: a.rel_tol,
         seed: a.seed,
         init: a.init.clone(),
+        init_params: a.params.clone(),
     };
     let bar = progress::bar(
         (a.sets * (a.iters.unwrap_or(1000) + 1)) as u64,
@@ -601,6 +613,7 @@ fn points_square(a: PointsArgs) -> anyhow::Result<()> {
         iters: a.iters,
         seed: a.seed,
         init: a.init.clone(),
+        init_params: a.params.clone(),
         members,
         score_seed,
     };
@@ -730,7 +743,7 @@ fn sheared_outputs(
     if let Some(prefix) = &a.png_prefix {
         projection_pngs(
             prefix,
-            &format!("{} {spec}", a.sampler),
+            &format!("{} {spec}", a.sampler_label()),
             a.n,
             &sets,
             &sheared,
@@ -792,7 +805,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
         );
     }
     let f = PixelIntegrand::parse(&a.integrand)?;
-    let sampler = registry::build(&a.sampler, a.n, Some(4), &[])?;
+    let sampler = registry::build(&a.sampler, a.n, Some(4), &a.params)?;
     let start = Instant::now();
     let options = PixelShearOptions {
         seed: a.seed,
@@ -830,7 +843,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
     let analysis = &found.analysis;
     let reduction = found.unsheared().estimate.variance / best.estimate.variance;
     let out = json!({
-        "sampler": a.sampler, "integrand": f.spec(), "n": a.n, "sets": a.sets, "seed": a.seed,
+        "sampler": a.sampler_label(), "integrand": f.spec(), "n": a.n, "sets": a.sets, "seed": a.seed,
         "estimator": "unshifted: mean of f over the transformed set (the render's); unbiased for every candidate",
         "pixel": {"kind": analysis.kind.name(), "depth": analysis.depth, "kappa": analysis.kappa, "kappas": analysis.kappas,
                   "footprint_kappa_range": found.slopes.range, "footprint_slope_spread": found.slopes.spread},
@@ -857,7 +870,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
             ""
         },
         if found.hairline { "; hairline" } else { "" },
-        a.sampler,
+        a.sampler_label(),
         a.n,
         best.estimate.realizations
     );
@@ -896,6 +909,14 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+impl ShearArgs {
+    /// The sampler as the outputs name it: its spec with the --param
+    /// values folded in.
+    fn sampler_label(&self) -> String {
+        registry::label(&self.sampler, &self.params).unwrap_or_else(|_| self.sampler.clone())
+    }
+}
+
 fn shear(a: ShearArgs) -> anyhow::Result<()> {
     use varspec::integrands;
     use varspec::optimize::shear::checked::{CheckVerdict, check_request, search_and_check};
@@ -914,7 +935,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
 
     let f = integrands::parse(&a.integrand)?;
     check_request(f.as_ref(), a.range, a.realizations)?;
-    let sampler = registry::build(&a.sampler, a.n, Some(4), &[])?;
+    let sampler = registry::build(&a.sampler, a.n, Some(4), &a.params)?;
     // The written sets, drawn and sheared (two copies), and a few numbers
     // per realization of the check.
     let bytes = 2.0 * a.sets as f64 * sampler.points_per_set() as f64 * 4.0 * 8.0
@@ -931,7 +952,7 @@ fn shear(a: ShearArgs) -> anyhow::Result<()> {
     let run = search_and_check(
         f.as_ref(),
         sampler.as_ref(),
-        &a.sampler,
+        &a.sampler_label(),
         a.seed,
         a.range,
         a.realizations,

@@ -32,6 +32,9 @@ pub struct ProjectionRequest {
     pub seed: u64,
     /// Starting 4D sampler (default umj).
     pub init: Option<String>,
+    /// Parameters of the starting sampler (`--param`), over its
+    /// shorthand's.
+    pub init_params: Vec<(String, String)>,
 }
 
 /// One projection term's loss before and after the descent (means over
@@ -107,8 +110,9 @@ pub fn design_projections(
         return Err(OptimizeError::Option("--sets must be at least 1".into()));
     }
     let terms = parse_projections(&r.target, r.n)?;
-    let init_name = r.init.clone().unwrap_or_else(|| "umj".into());
-    let init = registry::build(&init_name, r.n, Some(4), &[])?;
+    let init_spec = r.init.clone().unwrap_or_else(|| "umj".into());
+    let init_name = registry::label(&init_spec, &r.init_params)?;
+    let init = registry::build(&init_spec, r.n, Some(4), &r.init_params)?;
     let options = AdamOptions {
         iters: r.iters.unwrap_or(1000),
         rel_tol: AdamOptions::checked_rel_tol(r.rel_tol.unwrap_or(1e-4))?,

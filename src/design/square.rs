@@ -51,6 +51,9 @@ pub struct SquareRequest {
     pub seed: u64,
     /// Starting sampler (default: [`crate::square::design::default_start`]).
     pub init: Option<String>,
+    /// Parameters of the starting sampler (`--param`), over its
+    /// shorthand's.
+    pub init_params: Vec<(String, String)>,
     /// Family members each score averages over.
     pub members: usize,
     /// Seed of the scoring members.
@@ -120,11 +123,12 @@ pub fn design_on_square(
     if let Some(i) = r.iters {
         options.iters = i;
     }
-    let init_name = r
+    let init_spec = r
         .init
         .clone()
         .unwrap_or_else(|| crate::square::design::default_start(r.n).into());
-    let (init, n) = registry::build_nearest(&init_name, r.n, Some(2), &[])?;
+    let init_name = registry::label(&init_spec, &r.init_params)?;
+    let (init, n) = registry::build_nearest(&init_spec, r.n, Some(2), &r.init_params)?;
     if n != r.n {
         return Err(SquareDesignError::Request(format!(
             "--init {init_name} cannot start from N = {} (nearest: {n}); pick another --init or N",

@@ -43,6 +43,9 @@ pub struct TorusRequest {
     pub seed: u64,
     /// Starting sampler (default: see [`TorusPlan::new`]).
     pub init: Option<String>,
+    /// Parameters of the starting sampler (`--param`), over its
+    /// shorthand's.
+    pub init_params: Vec<(String, String)>,
     /// NUFFT tolerance (default from the target).
     pub tol: Option<f64>,
     /// Relative-improvement stopping rule (default from the target).
@@ -185,7 +188,7 @@ impl TorusPlan {
         };
         let has_integrand = integrand.is_some();
         let exact_form = integrand.filter(|f| f.has_autocov());
-        let init_name = r.init.clone().unwrap_or_else(|| {
+        let init_spec = r.init.clone().unwrap_or_else(|| {
             match &exact_form {
                 // The lattice search holds up to MAX_POINTS points; beyond,
                 // the default is the next best start.
@@ -195,6 +198,7 @@ impl TorusPlan {
             }
             .into()
         });
+        let init_name = registry::label(&init_spec, &r.init_params)?;
         let iters = r.iters.unwrap_or(1000);
         let mut options = DescentOptions::for_target(r.n, r.dim, &target);
         options.iters = iters;
@@ -243,7 +247,10 @@ impl TorusPlan {
             let found = best_lattice(r.n, f.as_ref())?;
             (Box::new(found.lattice), Some(found))
         } else {
-            (registry::build(&init_name, r.n, Some(r.dim), &[])?, None)
+            (
+                registry::build(&init_spec, r.n, Some(r.dim), &r.init_params)?,
+                None,
+            )
         };
         let plan_bytes = nufft_memory_bytes(optimizer.frequencies()).unwrap_or(f64::INFINITY);
         // An upper bound: the plans (the coarse phase's too, about a

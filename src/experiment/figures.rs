@@ -818,6 +818,7 @@ impl FigureExperiment {
                         rel_tol: None,
                         seed: self.seed,
                         init: None,
+                        init_params: Vec::new(),
                     },
                     &|_, _| {},
                 )?;

@@ -569,6 +569,7 @@ fn square_section(o: &TourOptions) -> Result<SquareSection, TourError> {
         iters: None,
         seed: o.seed,
         init: None,
+        init_params: Vec::new(),
         members: 1024,
         score_seed: 1,
     };
