@@ -187,6 +187,57 @@ pub fn npy_path(text: &str) -> Result<std::path::PathBuf, String> {
     path_for(text, "npy", "NumPy .npy array", None)
 }
 
+/// Extensions of formats a file of another format must not carry (the
+/// tool's own and the usual pictures and documents); a name ending in
+/// another (`.txt`, `.dat`, `.f32`) is left to the user.
+pub const KNOWN_FORMATS: [&str; 14] = [
+    "csv", "npy", "npz", "png", "jpg", "jpeg", "pfm", "exr", "json", "pdf", "svg", "h", "hpp",
+    "html",
+];
+
+/// A CSV table's path ([`path_for`]): `--csv r.png` wrote CSV under a
+/// picture's name.
+///
+/// # Errors
+/// A sentence naming the path.
+pub fn csv_path(text: &str) -> Result<std::path::PathBuf, String> {
+    path_for(text, "csv", "CSV table", Some(&KNOWN_FORMATS))
+}
+
+/// A JSON document's path ([`path_for`]): `--report r.csv` wrote JSON
+/// under a table's name.
+///
+/// # Errors
+/// A sentence naming the path.
+pub fn json_path(text: &str) -> Result<std::path::PathBuf, String> {
+    path_for(text, "json", "JSON document", Some(&KNOWN_FORMATS))
+}
+
+/// Refuses an output `path` whose extension names another format than
+/// those in `own` (`what` is written there): for outputs whose format is
+/// an option, checked once it is known.
+///
+/// # Errors
+/// A sentence naming the path and the format.
+pub fn check_extension(path: &std::path::Path, own: &[&str], what: &str) -> anyhow::Result<()> {
+    let given = path.extension().map(|e| e.to_string_lossy().to_lowercase());
+    match given {
+        Some(given)
+            if KNOWN_FORMATS.contains(&given.as_str()) && !own.contains(&given.as_str()) =>
+        {
+            anyhow::bail!(
+                "`{}`: {what} is written here (not .{given}); {}",
+                path.display(),
+                match own.first() {
+                    Some(ext) => format!("name the file .{ext}"),
+                    None => "name the file without a format's extension (e.g. .bin)".into(),
+                }
+            )
+        }
+        _ => Ok(()),
+    }
+}
+
 /// A point-set file's path: CSV, or NumPy .npy when the name ends in .npy
 /// (any other name is CSV: `.txt`, `.dat`). A name whose extension says
 /// another format (`t.npz`, `t.png`, `t.json`) would get CSV text under it,

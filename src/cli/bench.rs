@@ -37,7 +37,7 @@ pub enum BenchCommand {
 #[derive(clap::Args)]
 pub struct ShearArgs {
     /// CSV of the table.
-    #[arg(long, default_value = "out/bench/bench-shear.csv")]
+    #[arg(value_parser = super::args::csv_path, long, default_value = "out/bench/bench-shear.csv")]
     csv: PathBuf,
     /// Skip N = 1024 and 4096.
     #[arg(long)]
@@ -47,7 +47,7 @@ pub struct ShearArgs {
 #[derive(clap::Args)]
 pub struct SamplersArgs {
     /// CSV of the table.
-    #[arg(long, default_value = "out/bench/bench-samplers.csv")]
+    #[arg(value_parser = super::args::csv_path, long, default_value = "out/bench/bench-samplers.csv")]
     csv: PathBuf,
     /// One run of 2^16 coordinates per case instead of the best of 3 runs
     /// of 2^20.
@@ -58,7 +58,7 @@ pub struct SamplersArgs {
 #[derive(clap::Args)]
 pub struct RenderArgs {
     /// CSV of the table.
-    #[arg(long, default_value = "out/bench/bench-render.csv")]
+    #[arg(value_parser = super::args::csv_path, long, default_value = "out/bench/bench-render.csv")]
     csv: PathBuf,
     /// Sphere tessellation of the five spheres, 0 to 7 (5: 102,400 sphere
     /// triangles, 102,412 in the scene; 7: 1,638,400 sphere triangles).
@@ -69,7 +69,7 @@ pub struct RenderArgs {
 #[derive(clap::Args)]
 pub struct PredictArgs {
     /// CSV of the table.
-    #[arg(long, default_value = "out/bench/bench-predict.csv")]
+    #[arg(value_parser = super::args::csv_path, long, default_value = "out/bench/bench-predict.csv")]
     csv: PathBuf,
     /// Skip R = 1e5 empirical runs and N = 4096.
     #[arg(long)]
@@ -79,7 +79,7 @@ pub struct PredictArgs {
 #[derive(clap::Args)]
 pub struct SpectrumArgs {
     /// CSV of the table.
-    #[arg(long, default_value = "out/bench/bench-spectrum.csv")]
+    #[arg(value_parser = super::args::csv_path, long, default_value = "out/bench/bench-spectrum.csv")]
     csv: PathBuf,
     /// Skip the 1,048,576-point case.
     #[arg(long)]

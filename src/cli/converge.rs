@@ -77,7 +77,7 @@ pub struct Args {
     #[arg(value_parser = super::args::frequency_box, allow_negative_numbers = true, long)]
     res: Option<usize>,
     /// CSV of N against variance.
-    #[arg(long)]
+    #[arg(value_parser = super::args::csv_path, long)]
     csv: Option<PathBuf>,
     /// Log-log PNG plot with reference slopes.
     #[arg(long, value_parser = super::args::png_path)]

@@ -145,10 +145,10 @@ pub struct PointsArgs {
     #[arg(value_parser = args::point_file_path, short = 'o', long = "output")]
     output: PathBuf,
     /// JSON report: loss curve, wall time, loss beside the classic samplers.
-    #[arg(long)]
+    #[arg(value_parser = super::args::json_path, long)]
     report: Option<PathBuf>,
     /// CSV of set 0's loss against wall time: iteration,seconds,loss.
-    #[arg(long)]
+    #[arg(value_parser = super::args::csv_path, long)]
     curve: Option<PathBuf>,
     /// Log-log PNG of set 0's loss against wall time, with the classic samplers' losses.
     #[arg(long, value_parser = super::args::png_path)]

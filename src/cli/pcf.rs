@@ -34,7 +34,7 @@ pub struct Args {
     #[arg(allow_negative_numbers = true, long)]
     bandwidth: Option<f64>,
     /// CSV output: r,r_rel,g (r_rel = r / r_max). Default: standard output.
-    #[arg(long)]
+    #[arg(value_parser = super::args::csv_path, long)]
     csv: Option<PathBuf>,
     /// PNG plot of g against r / r_max.
     #[arg(long, value_parser = super::args::png_path)]

@@ -81,10 +81,10 @@ pub struct Args {
     #[arg(long)]
     reference: Option<PathBuf>,
     /// Summary JSON: variance statistics, MSE, time.
-    #[arg(long)]
+    #[arg(value_parser = super::args::json_path, long)]
     summary: Option<PathBuf>,
     /// Per-pixel analysis CSV: px,py,kind,depth,kappa,shear_form,a,b.
-    #[arg(long)]
+    #[arg(value_parser = super::args::csv_path, long)]
     analysis: Option<PathBuf>,
     /// Heat map PNG of the light-field slope κ each pixel's shear follows.
     #[arg(long, value_parser = super::args::png_path)]

@@ -47,14 +47,14 @@ pub struct Args {
     tol: Option<f64>,
     /// CSV of the spectrum: kx,ky,power (a projection's axes: kx,ku,power
     /// for --dims 0,2).
-    #[arg(long)]
+    #[arg(value_parser = super::args::csv_path, long)]
     csv: Option<PathBuf>,
     /// NumPy float64 array [S, S] of the spectrum, S = 2h + 1 with h the
     /// largest |k| in the box: row k_y + h, column k_x + h (DC at the centre).
     #[arg(value_parser = super::args::npy_path, long)]
     npy: Option<PathBuf>,
     /// CSV of the radial profile: k,power,anisotropy.
-    #[arg(long)]
+    #[arg(value_parser = super::args::csv_path, long)]
     radial: Option<PathBuf>,
     /// PNG heat map of the spectrum (log scale, centred at DC).
     #[arg(long, value_parser = super::args::png_path)]

@@ -92,6 +92,14 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             a.output.display()
         )
     })?;
+    // `--format f32 -o t.csv` wrote raw floats under a table's name.
+    let (own, what): (&[&str], _) = match format {
+        FormatArg::Csv => (&["csv"], "a CSV table"),
+        FormatArg::Json => (&["json"], "a JSON table"),
+        FormatArg::CHeader => (&["h", "hpp"], "a C header"),
+        FormatArg::F32 | FormatArg::F64 => (&[], "a table of raw binary floats"),
+    };
+    super::args::check_extension(&a.output, own, what)?;
     let format = match format {
         FormatArg::Csv => TableFormat::Csv,
         FormatArg::Json => TableFormat::Json,
