@@ -806,6 +806,13 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
     }
     let f = PixelIntegrand::parse(&a.integrand)?;
     let sampler = registry::build(&a.sampler, a.n, Some(4), &a.params)?;
+    if sampler.points_per_set() < 2 {
+        bail!(
+            "the shear search needs at least 2 points per set (as on a light field): every \
+             candidate moves one uniform point to a uniform point, so their variances are equal \
+             and a measured difference is noise"
+        );
+    }
     let start = Instant::now();
     let options = PixelShearOptions {
         seed: a.seed,
@@ -905,6 +912,30 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
             "no lower".to_string()
         }
     );
+    let unsheared = &found.unsheared().estimate;
+    if found.chosen != 0 && best.estimate.ci_high >= unsheared.ci_low {
+        eprintln!(
+            "note: the chosen shear's 95% interval [{:.4e}, {:.4e}] meets no shear's [{:.4e}, {:.4e}]: \
+             the gain is not resolved at these realizations",
+            best.estimate.ci_low, best.estimate.ci_high, unsheared.ci_low, unsheared.ci_high
+        );
+    }
+    let relative = best.estimate.stderr / best.estimate.variance;
+    let defaults = PixelShearOptions::default();
+    if relative > defaults.target_stderr {
+        eprintln!(
+            "note: the chosen shear's variance is known to {:.1}% (the search aims at {:.0}%) after \
+             {} realizations per candidate ({}): candidates closer than that are not told apart",
+            100.0 * relative,
+            100.0 * defaults.target_stderr,
+            best.estimate.realizations,
+            if best.estimate.realizations >= defaults.max_realizations {
+                "the most it draws"
+            } else {
+                "its third round"
+            }
+        );
+    }
     report_shear_outputs(&a, true);
     Ok(())
 }
