@@ -1514,6 +1514,31 @@ fn long_work_off_a_terminal_logs_its_progress() {
 }
 
 #[test]
+fn work_of_unknown_length_off_a_terminal_logs_its_stage() {
+    // `optimize shear` shows a spinner with its stage on a terminal; off
+    // one it said nothing for minutes (helper's probe: 40 s silent at
+    // VARSPEC_PROGRESS_SECONDS=5). This search takes ~2 s on 2 cores.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_varspec"))
+        .args([
+            "optimize",
+            "shear",
+            "-n",
+            "1024",
+            "--integrand",
+            "defocus:c=0.5",
+        ])
+        .env("VARSPEC_PROGRESS_SECONDS", "1")
+        .output()
+        .unwrap();
+    let logged = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{logged}");
+    assert!(
+        logged.contains("varspec: searching the shear") && logged.contains(": running for 1 s"),
+        "{logged}"
+    );
+}
+
+#[test]
 fn the_spatial_forms_cost_is_told_before_it_runs() {
     // `predict -n 1e6 --method spatial` ran for hours with no word (fourth
     // trial). The note comes before the work: read it, then stop the run.

@@ -47,6 +47,8 @@ enum Shown {
     Steps,
     /// "42%".
     Percent,
+    /// The bar's current message (a spinner's stage) and the time alone.
+    Elapsed,
 }
 
 fn counted_bar(len: u64, what: &str, shown: Shown) -> ProgressBar {
@@ -65,6 +67,7 @@ fn counted_bar(len: u64, what: &str, shown: Shown) -> ProgressBar {
     let template = match shown {
         Shown::Steps => "{msg} [{bar:40}] {pos}/{len} ({eta} left)",
         Shown::Percent => "{msg} [{bar:40}] {percent}% ({eta} left)",
+        Shown::Elapsed => "{msg} ({elapsed})",
     };
     bar.set_style(
         ProgressStyle::with_template(template)
@@ -76,10 +79,17 @@ fn counted_bar(len: u64, what: &str, shown: Shown) -> ProgressBar {
 }
 
 /// A spinner with the elapsed time for work of unknown length labelled
-/// `what`; hidden off a terminal. Finish it with `finish_and_clear`.
+/// `what` (its message, which the work may change to name its stage); off
+/// a terminal, a hidden one whose message and elapsed time are logged (see
+/// the module docs). Finish it with `finish_and_clear`.
 pub fn spinner(what: &str) -> ProgressBar {
     if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
+        let spinner = ProgressBar::hidden();
+        spinner.set_message(what.to_string());
+        if let Some(every) = log_every() {
+            log_while_running(&spinner, what.to_string(), every, Shown::Elapsed);
+        }
+        return spinner;
     }
     let spinner = ProgressBar::new_spinner();
     spinner.set_style(
@@ -120,14 +130,22 @@ fn log_while_running(bar: &ProgressBar, what: String, every: Duration, shown: Sh
             } else {
                 String::new()
             };
-            let done = match shown {
-                Shown::Steps => format!("{pos} of {len}"),
-                Shown::Percent => format!("{:.0}% done", 100.0 * pos as f64 / len.max(1) as f64),
-            };
-            eprintln!(
-                "varspec: {what}: {done} after {}{left}",
-                duration_words(elapsed)
-            );
+            match shown {
+                Shown::Steps => eprintln!(
+                    "varspec: {what}: {pos} of {len} after {}{left}",
+                    duration_words(elapsed)
+                ),
+                Shown::Percent => eprintln!(
+                    "varspec: {what}: {:.0}% done after {}{left}",
+                    100.0 * pos as f64 / len.max(1) as f64,
+                    duration_words(elapsed)
+                ),
+                Shown::Elapsed => eprintln!(
+                    "varspec: {}: running for {}",
+                    bar.message(),
+                    duration_words(elapsed)
+                ),
+            }
         }
     });
 }
