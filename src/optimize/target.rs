@@ -86,8 +86,9 @@ impl Target {
                 known,
                 suggestion,
             }) => Err(fail(format!(
-                "`{name}`{suggestion} is neither an integrand ({known}) nor family:disks, \
-                 power:A or radial:FILE.csv"
+                "`{name}`{} is neither an integrand ({known}) nor family:disks, \
+                 power:A or radial:FILE.csv",
+                elsewhere(&name).unwrap_or(suggestion)
             ))),
             Err(e) => Err(e.into()),
         }
@@ -241,6 +242,25 @@ fn read_radial(path: &Path) -> Result<Vec<(f64, f64)>, String> {
     // largest weight keeps the loss and its gradient finite (weights near
     // f64::MAX would overflow them).
     Ok(table.into_iter().map(|(k, w)| (k, w / largest)).collect())
+}
+
+/// What an unknown torus target's name is where it means something: a
+/// plane of a 4D set, or a family of the unit square.
+fn elsewhere(name: &str) -> Option<String> {
+    const PLANES: [&str; 6] = ["xy", "uv", "xu", "yv", "xv", "yu"];
+    let name = name.trim().to_lowercase();
+    if name.len() == 2 && name.chars().all(|c| "xyuv".contains(c)) {
+        return Some(if PLANES.contains(&name.as_str()) {
+            " (a plane of a 4D set: projection targets such as `xy:family:disks;uv:family:disks` \
+             need -d 4)"
+                .to_string()
+        } else {
+            format!(" (planes of a 4D set: {})", PLANES.join(", "))
+        });
+    }
+    ["gaussians", "halfplanes", "disks", "boxes"]
+        .contains(&name.as_str())
+        .then(|| " (a family of the unit square: --domain square)".to_string())
 }
 
 /// The files a target spec of `optimize points` reads on `domain`, split

@@ -72,11 +72,18 @@ pub fn parse_target(spec: &str) -> Result<Vec<SquareTerm>, FamilyError> {
         reason,
     };
     let mut terms = Vec::new();
-    for part in spec.split('+') {
+    for (i, part) in spec.split('+').enumerate() {
         let (weight, family) = match part.split_once('*') {
             Some((w, f)) => (crate::spec_params::term_weight(w).map_err(fail)?, f),
             None => (1.0, part),
         };
+        if family.trim().is_empty() {
+            return Err(fail(format!(
+                "term {} is empty (a `+` with nothing on one side): terms are families or `blue`, \
+                 e.g. `halfplanes+gaussians+16*blue`",
+                i + 1
+            )));
+        }
         let kind = if family.trim() == "blue" {
             TermKind::Blue
         } else {
