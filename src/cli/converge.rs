@@ -567,13 +567,21 @@ pub fn run(a: Args) -> anyhow::Result<()> {
         .map(|p| format!("N = {} ({:.2}×)", p.n, p.truncation_bound / p.variance))
         .collect();
     if !loose.is_empty() {
+        // The spatial form needs a closed-form autocovariance (not defocus
+        // or layers).
+        let spatial = matches!(&subject, Subject::Torus(f) if f.has_autocov());
         eprintln!(
             "note: the Fourier box's truncation bound exceeds {:.0}% of the value at {}: {}, \
              so those values and the slope through them are uncertain by that much; raise \
-             --res, or use --method spatial",
+             --res{}",
             100.0 * super::args::LOOSE_TRUNCATION,
             loose.join(", "),
-            super::args::NOT_WHITE_BEYOND_THE_BOX
+            super::args::NOT_WHITE_BEYOND_THE_BOX,
+            if spatial {
+                ", or use --method spatial"
+            } else {
+                " (the spatial form needs a closed-form autocovariance, which this integrand lacks)"
+            }
         );
     }
     let ci = fit

@@ -355,9 +355,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     // on as many sets as reach it (variance::sets).
     let mut drawn = Vec::new();
     // A sampler's sets vary from draw to draw unless they are shifts of one
-    // set (regular, uniform jitter, lattices), whose spatial values agree.
-    let random_sets =
-        matches!(&source, Source::Sampler { sampler, .. } if !sampler.shifts_of_one_set());
+    // set (regular, uniform jitter, lattices) or single points, whose
+    // spatial values agree (one point's is Var f, with no pairs at all).
+    let random_sets = matches!(&source, Source::Sampler { sampler, .. }
+        if !sampler.shifts_of_one_set() && sampler.points_per_set() > 1);
     if wants(MethodArg::Fourier) || wants(MethodArg::Spatial) || wants(MethodArg::Radial) {
         drawn = source.realizations()?;
         let relative = set_forms(&a, f.as_ref(), &drawn, random_sets, &wants, &mut out)?;
@@ -443,7 +444,7 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             }),
         );
     }
-    note_loose_bounds(&out);
+    note_loose_bounds(&out, f.has_autocov());
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&Value::Object(out))?);
         return Ok(());
@@ -577,10 +578,15 @@ const LOOSE_ANISOTROPY: f64 = 0.5;
 /// Fourier forms' truncation bound (the box leaves out energy the sampler
 /// does not whiten) and the radial form's anisotropy bound. The values are
 /// printed either way; the note says they are uncertain by that much.
-fn note_loose_bounds(out: &serde_json::Map<String, Value>) {
+fn note_loose_bounds(out: &serde_json::Map<String, Value>, spatial: bool) {
     let truncation = format!(
-        "{}: raise --res, or trust spatial",
-        args::NOT_WHITE_BEYOND_THE_BOX
+        "{}: raise --res, or {}",
+        args::NOT_WHITE_BEYOND_THE_BOX,
+        if spatial {
+            "trust spatial"
+        } else {
+            "compare --method empirical (this integrand has no closed-form autocovariance for the spatial form)"
+        }
     );
     for (key, bound, loose, why) in [
         (
@@ -769,7 +775,6 @@ fn square(a: &Args, members: usize) -> anyhow::Result<()> {
             json!({"mse": closed, "directions": q, "seconds": start.elapsed().as_secs_f64()}),
         );
     }
-    note_loose_bounds(&out);
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&Value::Object(out))?);
         return Ok(());
