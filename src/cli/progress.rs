@@ -64,18 +64,19 @@ fn counted_bar(len: u64, what: &str, shown: Shown) -> ProgressBar {
         return bar;
     }
     let bar = ProgressBar::new(len);
-    let template = match shown {
-        Shown::Steps => "{msg} [{bar:40}] {pos}/{len} ({eta} left)",
-        Shown::Percent => "{msg} [{bar:40}] {percent}% ({eta} left)",
-        Shown::Elapsed => "{msg} ({elapsed})",
-    };
-    bar.set_style(
-        ProgressStyle::with_template(template)
-            .expect("static template")
-            .progress_chars("=> "),
-    );
+    bar.set_style(style(shown).progress_chars("=> "));
     bar.set_message(what.to_string());
     bar
+}
+
+/// How a bar of each kind is drawn on a terminal.
+fn style(shown: Shown) -> ProgressStyle {
+    ProgressStyle::with_template(match shown {
+        Shown::Steps => "{msg} [{bar:40}] {pos}/{len} ({eta} left)",
+        Shown::Percent => "{msg} [{bar:40}] {percent}% ({eta} left)",
+        Shown::Elapsed => "{spinner} {msg} ({elapsed})",
+    })
+    .expect("static template")
 }
 
 /// A spinner with the elapsed time for work of unknown length labelled
@@ -92,9 +93,7 @@ pub fn spinner(what: &str) -> ProgressBar {
         return spinner;
     }
     let spinner = ProgressBar::new_spinner();
-    spinner.set_style(
-        ProgressStyle::with_template("{spinner} {msg} ({elapsed})").expect("static template"),
-    );
+    spinner.set_style(style(Shown::Elapsed));
     spinner.set_message(what.to_string());
     spinner.enable_steady_tick(std::time::Duration::from_millis(200));
     spinner
