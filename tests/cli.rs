@@ -1533,7 +1533,7 @@ fn work_of_unknown_length_off_a_terminal_logs_its_stage() {
     let logged = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{logged}");
     assert!(
-        logged.contains("varspec: searching the shear") && logged.contains(": running for 1 s"),
+        logged.contains("varspec: searching the shear") && logged.contains(": running for "),
         "{logged}"
     );
 }

@@ -912,14 +912,6 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
             "no lower".to_string()
         }
     );
-    let unsheared = &found.unsheared().estimate;
-    if found.chosen != 0 && best.estimate.ci_high >= unsheared.ci_low {
-        eprintln!(
-            "note: the chosen shear's 95% interval [{:.4e}, {:.4e}] meets no shear's [{:.4e}, {:.4e}]: \
-             the gain is not resolved at these realizations",
-            best.estimate.ci_low, best.estimate.ci_high, unsheared.ci_low, unsheared.ci_high
-        );
-    }
     let relative = best.estimate.stderr / best.estimate.variance;
     let defaults = PixelShearOptions::default();
     if relative > defaults.target_stderr {
@@ -932,7 +924,7 @@ fn shear_pixel(a: ShearArgs) -> anyhow::Result<()> {
             if best.estimate.realizations >= defaults.max_realizations {
                 "the most it draws"
             } else {
-                "its third round"
+                "its last round"
             }
         );
     }

@@ -276,7 +276,8 @@ pub fn files_read(spec: &str, domain: crate::optimize::adam::Domain) -> Vec<&Pat
         Domain::Torus => (';', "radial:"),
         Domain::Square => ('+', "file:"),
     };
-    spec.split(separator)
+    let mut files: Vec<&Path> = spec
+        .split(separator)
         .filter_map(|part| {
             let part = match domain {
                 Domain::Square => part.split_once('*').map_or(part, |(_, family)| family),
@@ -285,7 +286,16 @@ pub fn files_read(spec: &str, domain: crate::optimize::adam::Domain) -> Vec<&Pat
             part.find(prefix).map(|at| &part[at + prefix.len()..])
         })
         .map(|path| Path::new(path.trim()))
-        .collect()
+        .collect();
+    // A 2D or 3D torus target is one `radial:FILE`, whose name may hold a
+    // `;` (only 4D projection targets are split there).
+    if let (Domain::Torus, Some(whole)) = (domain, spec.strip_prefix("radial:")) {
+        let whole = Path::new(whole.trim());
+        if !files.contains(&whole) {
+            files.push(whole);
+        }
+    }
+    files
 }
 
 #[cfg(test)]
@@ -300,6 +310,8 @@ mod tests {
             ("radial:w.csv", Torus, vec!["w.csv"]),
             // A `+` in a torus target's file name is part of it.
             ("radial:w+1.csv", Torus, vec!["w+1.csv"]),
+            // ... and so may a `;` (the 4D reading is kept too).
+            ("radial:w;1.csv", Torus, vec!["w", "w;1.csv"]),
             (
                 "xu:radial:a+b.csv;yv:power:3;uv:radial:b.csv",
                 Torus,

@@ -225,7 +225,8 @@ impl PoissonDisk {
                 };
                 mappable = open.is_some();
             }
-            if open.as_ref().is_some_and(OpenCells::is_empty) {
+            // The last point may fill the last open cell: that set is full.
+            if disks.len() < n && open.as_ref().is_some_and(OpenCells::is_empty) {
                 return (disks.coords, Ending::Saturated);
             }
         }
@@ -569,6 +570,25 @@ mod tests {
             (mean - 0.547067).abs() < half,
             "covering fraction {mean} ± {half} (99.9% CI) excludes 0.547067: {fractions:?}"
         );
+    }
+
+    #[test]
+    fn a_set_whose_last_point_fills_the_torus_is_full() {
+        // N equal to the count at saturation: the N-th point empties the
+        // map, and the set is complete, not out of room (review: these two
+        // were reported as "no room for point 41 of 40" and "42 of 41").
+        for (n, radius, seed) in [
+            (40, 0.775_671_751_881_339_6, 1),
+            (41, 0.785_307_795_283_692_2, 81),
+        ] {
+            let sampler = PoissonDisk::new(n, 2, radius, u64::MAX).unwrap();
+            let (coords, ending) = sampler.throw_darts(&mut set_rng(seed, 0));
+            assert_eq!((ending, coords.len() / 2), (Ending::Full, n), "N = {n}");
+            assert!(
+                covers_the_torus(&coords, sampler.radius()),
+                "N = {n}: saturated too"
+            );
+        }
     }
 
     #[test]
