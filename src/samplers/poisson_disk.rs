@@ -69,7 +69,7 @@ impl PoissonDisk {
             return Err(param(
                 "max-trials",
                 "0".into(),
-                "`auto` or a positive integer",
+                "`auto` or a positive whole number",
             ));
         }
         let sampler = PoissonDisk {
@@ -93,9 +93,13 @@ impl PoissonDisk {
         self.rho * packing_radius(self.n, self.dim).expect("d in 2..=4, checked when built")
     }
 
-    /// Cells per axis: the most whose side 1/g is still ≥ r.
+    /// Cells per axis: the most whose side 1/g is still ≥ r, but no more
+    /// than about 4 cells per point (a tiny radius would ask for a grid of
+    /// more cells than memory holds; larger cells only hold more points).
     fn cells_per_axis(&self) -> usize {
-        ((1.0 / self.radius()).floor() as usize).max(1)
+        let fine = (1.0 / self.radius()).floor();
+        let enough = (4.0 * self.n as f64).powf(1.0 / self.dim as f64).ceil();
+        (fine.min(enough) as usize).max(1)
     }
 }
 
@@ -116,8 +120,14 @@ pub(crate) fn from_config(c: &Config) -> Result<Box<dyn Sampler>, SamplerError> 
         text => text
             .parse::<u64>()
             .ok()
+            .or_else(|| {
+                // Whole scientific notation, as counts on the command line
+                // (1e9); beyond u64 or fractional is refused.
+                let v: f64 = text.parse().ok()?;
+                (v.fract() == 0.0 && (1.0..1.8e19).contains(&v)).then_some(v as u64)
+            })
             .filter(|&t| t >= 1)
-            .ok_or_else(|| c.bad_param("max-trials", "`auto` or a positive integer"))?,
+            .ok_or_else(|| c.bad_param("max-trials", "`auto` or a positive whole number"))?,
     };
     Ok(Box::new(PoissonDisk::new(c.n, c.dim, rho, max_trials)?))
 }
@@ -206,15 +216,16 @@ impl PoissonDisk {
             if let (Some(cells), Some(k)) = (open.as_mut(), cell) {
                 cells.drop_if_covered(k, &disks);
             }
-            // Patience, in misses in a row: 2^d per point asked for (at
-            // least 4096) before the first map, about what the map costs
-            // (≈ 2^d N / ρ^d cubes tested) — sets below jamming never get
-            // there (the default ρ = 0.7 misses a few hundred in a row at
-            // its last points); then as many as the 2^d halves a
+            // Patience, in misses in a row: 4096 before the first map —
+            // sets below jamming never get there (the default ρ = 0.7
+            // misses a few hundred in a row at its last points, whatever
+            // N), and near jamming plain throwing needs far more darts
+            // than the map costs (2^d per point waited for N ≥ 10^5 out of
+            // the default max-trials) — then as many as the 2^d halves a
             // refinement would test, so throws and refinements share the
             // time.
             let patience = match &open {
-                None => ((n as u64) << self.dim).max(4096),
+                None => 4096,
                 Some(cells) => ((cells.len() as u64) << self.dim) + 64,
             };
             if missed >= patience && mappable {
