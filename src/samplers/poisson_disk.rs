@@ -313,10 +313,7 @@ impl Disks {
 
     fn insert(&mut self, x: &[f64]) {
         let cell = self.locate(x);
-        let home = cell[..self.dim]
-            .iter()
-            .rev()
-            .fold(0usize, |acc, &c| acc * self.g + c as usize);
+        let home = cell_index(&cell[..self.dim], &[0; 4][..self.dim], self.g);
         self.next.push(self.head[home]);
         self.head[home] = (self.next.len() - 1) as u32;
         self.coords.extend_from_slice(x);
@@ -437,10 +434,14 @@ impl OpenCells {
         axes.map(|a| a as f64 / self.m as f64)
     }
 
+    /// Whether one disk covers cell `c`.
+    fn covered(&self, c: u64, disks: &Disks) -> bool {
+        disks.covers(&self.corner(c)[..self.dim], 1.0 / self.m as f64)
+    }
+
     fn keep_uncovered(&mut self, disks: &Disks) {
-        let side = 1.0 / self.m as f64;
         let mut cells = std::mem::take(&mut self.cells);
-        cells.retain(|&c| !disks.covers(&self.corner(c)[..self.dim], side));
+        cells.retain(|&c| !self.covered(c, disks));
         self.checked = vec![disks.len() as u32; cells.len()];
         self.cells = cells;
     }
@@ -463,8 +464,7 @@ impl OpenCells {
         if self.checked[k] == placed {
             return;
         }
-        let side = 1.0 / self.m as f64;
-        if disks.covers(&self.corner(self.cells[k])[..self.dim], side) {
+        if self.covered(self.cells[k], disks) {
             self.cells.swap_remove(k);
             self.checked.swap_remove(k);
         } else {
